@@ -1,0 +1,13 @@
+#include <cstdio>
+
+#include "tools/commands.h"
+
+namespace ceres_sesync::tools {
+
+// Placeholder until the owning issue lands.
+int RunCertify(const Args&) {
+  std::fputs("ceres_sesync certify: not implemented yet\n", stderr);
+  return kUsageOrInputError;
+}
+
+}  // namespace ceres_sesync::tools
