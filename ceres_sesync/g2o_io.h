@@ -26,7 +26,9 @@
 //
 // The reader rejects, with a message "PATH:LINE: what is wrong": malformed,
 // short or over-long lines, non-numeric tokens, NaN/Inf, bad quaternions,
-// information matrices that are not positive definite, mixed 2D/3D tags,
+// information matrices whose translational or rotational diagonal block is not
+// positive definite (the full matrix may be indefinite: its cross terms are
+// not used; see G2oReadSummary), mixed 2D/3D tags,
 // self-loops, unsupported tags (unless skipped by option; the legacy 3D TORO
 // tags VERTEX3/EDGE3 are always rejected), edges to vertices without a VERTEX
 // line when the file has VERTEX lines, duplicate VERTEX ids, files without
@@ -68,6 +70,11 @@ struct G2oReadSummary {
   // Number of quaternions whose length differed from 1 by more than 1e-12
   // and that were normalized.
   int num_normalized_quaternions = 0;
+  // Number of edges whose full information matrix is not positive definite
+  // although its translational and rotational blocks are (e.g. 5021 edges of
+  // cubicle.g2o). Only those blocks enter kappa and tau, so such edges are
+  // accepted; the cross terms are ignored as for every edge.
+  int num_indefinite_information = 0;
   // Whether the file has a FIX line (see PoseGraph::fixed_pose).
   bool has_fix = false;
 };
