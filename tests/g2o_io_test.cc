@@ -674,10 +674,11 @@ TEST(DatasetsTest, AllLoadWithTheExpectedSizes) {
                           .count();
     std::printf(
         "  %-20s d=%d poses=%6d edges=%6d normalized quaternions=%5d "
-        "read in %7.2f ms\n",
+        "indefinite information=%5d read in %6.2f ms\n",
         dataset.file, graph.dimension, graph.num_poses,
         static_cast<int>(graph.measurements.size()),
-        summary.num_normalized_quaternions, ms);
+        summary.num_normalized_quaternions, summary.num_indefinite_information,
+        ms);
     EXPECT_EQ(graph.dimension, dataset.dimension);
     EXPECT_EQ(static_cast<int>(graph.measurements.size()), dataset.edges);
     EXPECT_EQ(graph.num_poses, static_cast<int>(ids.size()));
