@@ -1,13 +1,142 @@
-#include <cstdio>
+// `ceres_sesync info GRAPH.g2o [--json PATH] [--skip_unsupported_tags]`:
+// reads a pose graph and describes it (dimension, sizes, connectivity, the
+// range of the precisions kappa and tau, initial guess, FIX, skipped lines).
 
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/internal/json_writer.h"
+#include "ceres_sesync/pose_graph.h"
 #include "tools/commands.h"
 
-namespace ceres_sesync::tools {
+DEFINE_bool(skip_unsupported_tags, false,
+            "Skip (and count) g2o lines with tags SE-Sync cannot use, such as "
+            "landmarks and priors, instead of rejecting the file.");
 
-// Placeholder until the owning issue lands.
-int RunInfo(const Args&) {
-  std::fputs("ceres_sesync info: not implemented yet\n", stderr);
-  return kUsageOrInputError;
+namespace ceres_sesync::tools {
+namespace {
+
+struct Range {
+  double min = 0, median = 0, max = 0;
+};
+
+Range RangeOf(std::vector<double> values) {
+  Range range;
+  if (values.empty()) return range;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  range.min = values.front();
+  range.max = values.back();
+  range.median =
+      n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  return range;
+}
+
+void AddRange(const char* key, const Range& range, internal::JsonWriter* json) {
+  json->BeginObject(key);
+  json->Number("min", range.min);
+  json->Number("median", range.median);
+  json->Number("max", range.max);
+  json->EndObject();
+}
+
+}  // namespace
+
+int RunInfo(const Args& args) {
+  if (args.size() != 1) {
+    std::fputs(
+        "usage: ceres_sesync info GRAPH.g2o [--json PATH] "
+        "[--skip_unsupported_tags]\n",
+        stderr);
+    return kUsageOrInputError;
+  }
+  const std::string& path = args[0];
+  G2oReadOptions options;
+  options.skip_unsupported_tags = FLAGS_skip_unsupported_tags;
+  PoseGraph graph;
+  G2oReadSummary summary;
+  std::string error;
+  const auto start = std::chrono::steady_clock::now();
+  if (!ReadG2oFile(path, options, &graph, &error, &summary)) {
+    std::fprintf(stderr, "ceres_sesync info: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  const double read_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+
+  std::vector<double> kappas, taus;
+  for (const auto& m : graph.measurements) {
+    kappas.push_back(m.kappa);
+    taus.push_back(m.tau);
+  }
+  const Range kappa = RangeOf(kappas);
+  const Range tau = RangeOf(taus);
+  const int num_components = ConnectedComponents(graph, nullptr);
+  const bool has_initial_guess = !graph.initial_poses.empty();
+
+  std::printf("file:                      %s\n", path.c_str());
+  std::printf("dimension:                 %d\n", graph.dimension);
+  std::printf("poses:                     %d\n", graph.num_poses);
+  std::printf("edges:                     %d\n", summary.num_edges);
+  std::printf("connected components:      %d\n", num_components);
+  std::printf("kappa min / median / max:  %.6g / %.6g / %.6g\n", kappa.min,
+              kappa.median, kappa.max);
+  std::printf("tau min / median / max:    %.6g / %.6g / %.6g\n", tau.min,
+              tau.median, tau.max);
+  std::printf("initial guess:             %s\n",
+              has_initial_guess ? "yes (VERTEX lines)" : "no");
+  if (graph.fixed_pose >= 0) {
+    std::printf("fixed vertex (FIX):        %lld\n",
+                static_cast<long long>(graph.vertex_ids[graph.fixed_pose]));
+  } else {
+    std::printf("fixed vertex (FIX):        none\n");
+  }
+  std::printf("skipped lines:             %d\n", summary.num_skipped_lines);
+  for (const auto& [tag, count] : summary.skipped_tags) {
+    std::printf("  %-24s %d\n", tag.c_str(), count);
+  }
+  std::printf("normalized quaternions:    %d\n",
+              summary.num_normalized_quaternions);
+  std::printf("indefinite information:    %d (cross terms ignored)\n",
+              summary.num_indefinite_information);
+  std::printf("read time:                 %.3f s\n", read_seconds);
+
+  if (!FLAGS_json.empty()) {
+    internal::JsonWriter json;
+    json.String("command", "info");
+    json.String("file", path);
+    json.Int("dimension", graph.dimension);
+    json.Int("num_poses", graph.num_poses);
+    json.Int("num_edges", summary.num_edges);
+    json.Int("num_components", num_components);
+    AddRange("kappa", kappa, &json);
+    AddRange("tau", tau, &json);
+    json.Bool("has_initial_guess", has_initial_guess);
+    json.Bool("has_fix", summary.has_fix);
+    if (graph.fixed_pose >= 0) {
+      json.Int("fixed_vertex_id", graph.vertex_ids[graph.fixed_pose]);
+    } else {
+      json.Null("fixed_vertex_id");
+    }
+    json.Int("num_skipped_lines", summary.num_skipped_lines);
+    json.BeginObject("skipped_tags");
+    for (const auto& [tag, count] : summary.skipped_tags) json.Int(tag, count);
+    json.EndObject();
+    json.Int("num_normalized_quaternions", summary.num_normalized_quaternions);
+    json.Int("num_indefinite_information", summary.num_indefinite_information);
+    json.Number("read_seconds", read_seconds);
+    if (!json.WriteToFile(FLAGS_json, &error)) {
+      std::fprintf(stderr, "ceres_sesync info: cannot write --json: %s\n",
+                   error.c_str());
+      return kUsageOrInputError;
+    }
+  }
+  return kSuccess;
 }
 
 }  // namespace ceres_sesync::tools
