@@ -1,0 +1,415 @@
+// Tests of the JSON writer and of the `ceres_sesync info` command (run as a
+// separate process, as a user would).
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "ceres_sesync/internal/json_writer.h"
+#include "gtest/gtest.h"
+
+namespace ceres_sesync {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---- a minimal strict JSON validator (RFC 8259) ---------------------------
+
+class JsonValidator {
+ public:
+  explicit JsonValidator(const std::string& text) : s_(text) {}
+
+  bool Valid() {
+    SkipSpace();
+    if (!Value()) return false;
+    SkipSpace();
+    return k_ == s_.size();
+  }
+
+ private:
+  void SkipSpace() {
+    while (k_ < s_.size() && (s_[k_] == ' ' || s_[k_] == '\n' ||
+                              s_[k_] == '\r' || s_[k_] == '\t')) {
+      ++k_;
+    }
+  }
+  bool Literal(const char* word) {
+    const std::string w(word);
+    if (s_.compare(k_, w.size(), w) != 0) return false;
+    k_ += w.size();
+    return true;
+  }
+  bool Digits() {
+    const size_t start = k_;
+    while (k_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[k_]))) {
+      ++k_;
+    }
+    return k_ > start;
+  }
+  bool Number() {
+    if (s_[k_] == '-') ++k_;
+    if (k_ < s_.size() && s_[k_] == '0') {
+      ++k_;
+    } else if (!Digits()) {
+      return false;
+    }
+    if (k_ < s_.size() && s_[k_] == '.') {
+      ++k_;
+      if (!Digits()) return false;
+    }
+    if (k_ < s_.size() && (s_[k_] == 'e' || s_[k_] == 'E')) {
+      ++k_;
+      if (k_ < s_.size() && (s_[k_] == '+' || s_[k_] == '-')) ++k_;
+      if (!Digits()) return false;
+    }
+    return true;
+  }
+  bool String() {
+    if (s_[k_] != '"') return false;
+    for (++k_; k_ < s_.size(); ++k_) {
+      const unsigned char c = s_[k_];
+      if (c == '"') {
+        ++k_;
+        return true;
+      }
+      if (c < 0x20) return false;
+      if (c == '\\') {
+        if (++k_ >= s_.size()) return false;
+        const char e = s_[k_];
+        if (e == 'u') {
+          for (int h = 0; h < 4; ++h) {
+            if (++k_ >= s_.size() ||
+                !std::isxdigit(static_cast<unsigned char>(s_[k_]))) {
+              return false;
+            }
+          }
+        } else if (std::string("\"\\/bfnrt").find(e) == std::string::npos) {
+          return false;
+        }
+      }
+    }
+    return false;
+  }
+  template <typename Item>
+  bool Sequence(char close, Item item) {
+    ++k_;
+    SkipSpace();
+    if (k_ < s_.size() && s_[k_] == close) {
+      ++k_;
+      return true;
+    }
+    while (true) {
+      SkipSpace();
+      if (!item()) return false;
+      SkipSpace();
+      if (k_ >= s_.size()) return false;
+      if (s_[k_] == close) {
+        ++k_;
+        return true;
+      }
+      if (s_[k_++] != ',') return false;
+    }
+  }
+  bool Value() {
+    if (k_ >= s_.size()) return false;
+    switch (s_[k_]) {
+      case '{':
+        return Sequence('}', [&] {
+          if (k_ >= s_.size() || !String()) return false;
+          SkipSpace();
+          if (k_ >= s_.size() || s_[k_++] != ':') return false;
+          SkipSpace();
+          return Value();
+        });
+      case '[':
+        return Sequence(']', [&] { return Value(); });
+      case '"':
+        return String();
+      case 't':
+        return Literal("true");
+      case 'f':
+        return Literal("false");
+      case 'n':
+        return Literal("null");
+      default:
+        return Number();
+    }
+  }
+
+  const std::string& s_;
+  size_t k_ = 0;
+};
+
+bool IsValidJson(const std::string& text) {
+  return JsonValidator(text).Valid();
+}
+
+TEST(JsonValidatorTest, RejectsInvalidDocuments) {
+  // The validator must be able to say no, or the tests below prove nothing.
+  EXPECT_TRUE(IsValidJson("{\"a\": [1, -2.5e+3, true, null, \"x\\n\"]}"));
+  for (const char* bad :
+       {"{", "{\"a\" 1}", "{\"a\": 1,}", "[01]", "[1.]", "{\"a\": nan}",
+        "\"tab\there\"", "[1] 2", "{\"a\": \"\\x\"}"}) {
+    EXPECT_FALSE(IsValidJson(bad)) << bad;
+  }
+}
+
+// ---- JsonWriter -------------------------------------------------------------
+
+TEST(JsonWriterTest, WritesValidNestedDocuments) {
+  internal::JsonWriter json;
+  json.String("name", "plain");
+  json.Int("count", -42);
+  json.Bool("flag", true);
+  json.Null("nothing");
+  json.BeginObject("empty");
+  json.EndObject();
+  json.BeginArray("list");
+  json.Number(1.5);
+  json.Int(7);
+  json.String("s");
+  json.Bool(false);
+  json.Null();
+  json.BeginObject();
+  json.Number("x", 2);
+  json.EndObject();
+  json.BeginArray();
+  json.EndArray();
+  json.EndArray();
+  const std::string text = json.ToString();
+  EXPECT_TRUE(IsValidJson(text)) << text;
+  EXPECT_NE(text.find("\"count\": -42"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"empty\": {}"), std::string::npos) << text;
+  EXPECT_NE(text.find("[1.5, 7, \"s\", false, null, {"), std::string::npos)
+      << text;
+}
+
+TEST(JsonWriterTest, EscapesStrings) {
+  const std::string nasty = std::string("q\"b\\s/\n\t\r\b\f") + '\x01' +
+                            '\x1f' + "\xc3\xa9" + "\xe2\x82\xac" + '\xff' +
+                            "\xc3";  // é, €, an invalid byte, a cut é.
+  internal::JsonWriter json;
+  json.String(nasty, nasty);
+  const std::string text = json.ToString();
+  EXPECT_TRUE(IsValidJson(text)) << text;
+  const std::string expected =
+      "\"q\\\"b\\\\s/\\n\\t\\r\\b\\f\\u0001\\u001f\xc3\xa9\xe2\x82\xac\\ufffd"
+      "\\ufffd\"";
+  EXPECT_NE(text.find(expected + ": " + expected), std::string::npos) << text;
+}
+
+TEST(JsonWriterTest, NumbersRoundTripAndNonFiniteIsNull) {
+  const double values[] = {0.1, 1.0 / 3, -2.5e-300, 1.7976931348623157e308,
+                           123456789012345678.0};
+  for (double v : values) {
+    std::string text;
+    internal::JsonWriter::AppendNumber(v, &text);
+    EXPECT_EQ(std::strtod(text.c_str(), nullptr), v) << text;
+    EXPECT_TRUE(IsValidJson(text)) << text;
+  }
+  for (double v : {std::numeric_limits<double>::quiet_NaN(),
+                   std::numeric_limits<double>::infinity(),
+                   -std::numeric_limits<double>::infinity()}) {
+    std::string text;
+    internal::JsonWriter::AppendNumber(v, &text);
+    EXPECT_EQ(text, "null");
+  }
+}
+
+// ---- the `info` command
+// -------------------------------------------------------
+
+std::string TempPath(const std::string& name) {
+  return testing::TempDir() + "info_command_test_" + std::to_string(getpid()) +
+         "_" + name;
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  ASSERT_TRUE(out.good()) << path;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr.
+};
+
+// Runs the tool with `args` (paths here contain no shell metacharacters).
+RunResult RunTool(const std::string& args) {
+  RunResult result;
+  const std::string command =
+      std::string(CERES_SESYNC_TOOL) + " " + args + " 2>&1";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  size_t n;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) {
+    result.output.append(buffer, n);
+  }
+  const int status = pclose(pipe);
+  if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
+  return result;
+}
+
+// The rest of the line after `label` in `text`, trimmed; "" if absent.
+std::string ValueAfter(const std::string& text, const std::string& label) {
+  const size_t at = text.find(label);
+  if (at == std::string::npos) return "";
+  size_t begin = at + label.size();
+  const size_t end = text.find('\n', begin);
+  while (begin < end && text[begin] == ' ') ++begin;
+  return text.substr(begin, end - begin);
+}
+
+// The number after `"key": ` at or after the first occurrence of `scope`.
+double JsonNumber(const std::string& json, const std::string& scope,
+                  const std::string& key) {
+  const size_t from = json.find(scope);
+  if (from == std::string::npos) return std::nan("");
+  const size_t at = json.find("\"" + key + "\": ", from);
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
+
+class InfoCommandTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::string(CERES_SESYNC_TOOL).empty()) {
+      GTEST_SKIP() << "the ceres_sesync program is not built";
+    }
+  }
+};
+
+// Three poses (ids 3, 7, 9), three edges with kappa 10, 30, 20 and isotropic
+// translational information 5 I (tau = 2 / trace(I/5) = 5), FIX 7.
+const char kGoodGraph[] =
+    "# a small graph\n"
+    "VERTEX_SE2 3 0 0 0\n"
+    "VERTEX_SE2 7 1 0 0\n"
+    "VERTEX_SE2 9 1 1 1.5\n"
+    "EDGE_SE2 3 7 1 0 0 5 0 0 5 0 10\n"
+    "EDGE_SE2 7 9 0 1 1.5 5 0 0 5 0 30\n"
+    "\n"
+    "EDGE_SE2 9 3 -1 1 -1.5 5 0 0 5 0 20\n"
+    "FIX 7\n";
+
+TEST_F(InfoCommandTest, DescribesAGoodFile) {
+  const std::string graph = TempPath("good.g2o");
+  const std::string json_path = TempPath("good.json");
+  WriteText(graph, kGoodGraph);
+  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "dimension:"), "2") << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "poses:"), "3") << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "edges:"), "3") << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "connected components:"), "1");
+  EXPECT_EQ(ValueAfter(run.output, "kappa min / median / max:"),
+            "10 / 20 / 30");
+  EXPECT_EQ(ValueAfter(run.output, "tau min / median / max:"), "5 / 5 / 5");
+  EXPECT_EQ(ValueAfter(run.output, "initial guess:"), "yes (VERTEX lines)");
+  EXPECT_EQ(ValueAfter(run.output, "fixed vertex (FIX):"), "7");
+  EXPECT_EQ(ValueAfter(run.output, "skipped lines:"), "0");
+
+  ASSERT_TRUE(fs::exists(json_path));
+  const std::string json = ReadText(json_path);
+  EXPECT_TRUE(IsValidJson(json)) << json;
+  for (const char* field :
+       {"\"command\": \"info\"", "\"dimension\": 2", "\"num_poses\": 3",
+        "\"num_edges\": 3", "\"num_components\": 1",
+        "\"has_initial_guess\": true", "\"has_fix\": true",
+        "\"fixed_vertex_id\": 7", "\"num_skipped_lines\": 0"}) {
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+  }
+  EXPECT_NE(json.find("\"file\": \"" + graph + "\""), std::string::npos)
+      << json;
+  EXPECT_EQ(JsonNumber(json, "\"kappa\"", "min"), 10);
+  EXPECT_EQ(JsonNumber(json, "\"kappa\"", "median"), 20);
+  EXPECT_EQ(JsonNumber(json, "\"kappa\"", "max"), 30);
+  // 2 / (2 / 5) may differ from 5 in the last bit.
+  EXPECT_NEAR(JsonNumber(json, "\"tau\"", "median"), 5, 1e-14);
+  fs::remove(graph);
+  fs::remove(json_path);
+}
+
+TEST_F(InfoCommandTest, BadFileExitsWithTwoNamingTheLineAndWritesNoJson) {
+  const std::string graph = TempPath("bad.g2o");
+  const std::string json_path = TempPath("bad.json");
+  WriteText(graph,
+            "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
+            "\n"
+            "EDGE_SE2 1 2 1 0 0 1 0 0 1 0 oops\n");
+  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find(graph + ":3: "), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(json_path));
+  fs::remove(graph);
+}
+
+TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
+  const std::string graph = TempPath("landmarks.g2o");
+  const std::string json_path = TempPath("landmarks.json");
+  WriteText(graph,
+            "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
+            "VERTEX_XY 5 1 2\n");
+  RunResult run = RunTool("info " + graph);
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find(graph + ":2: unsupported tag 'VERTEX_XY'"),
+            std::string::npos)
+      << run.output;
+
+  run =
+      RunTool("info " + graph + " --skip_unsupported_tags --json " + json_path);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "skipped lines:"), "1") << run.output;
+  const std::string json = ReadText(json_path);
+  EXPECT_TRUE(IsValidJson(json)) << json;
+  EXPECT_NE(json.find("\"num_skipped_lines\": 1"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"VERTEX_XY\": 1"), std::string::npos) << json;
+  fs::remove(graph);
+  fs::remove(json_path);
+}
+
+TEST_F(InfoCommandTest, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(RunTool("info").exit_code, 2);
+  const std::string missing = TempPath("missing.g2o");
+  const RunResult run = RunTool("info " + missing);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find(missing), std::string::npos) << run.output;
+  // An unwritable --json path is an error too.
+  const std::string graph = TempPath("good2.g2o");
+  WriteText(graph, kGoodGraph);
+  EXPECT_EQ(RunTool("info " + graph + " --json " + TempPath("no_dir/x.json"))
+                .exit_code,
+            2);
+  fs::remove(graph);
+}
+
+TEST_F(InfoCommandTest, DescribesABenchmarkDataset) {
+  const std::string path = std::string(CERES_SESYNC_DATA_DIR) + "/CSAIL.g2o";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
+  const RunResult run = RunTool("info " + path);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "edges:"), "1172") << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "poses:"), "1045") << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "initial guess:"), "no") << run.output;
+}
+
+}  // namespace
+}  // namespace ceres_sesync
