@@ -1,13 +1,130 @@
-#include <cstdio>
+// `ceres_sesync solve GRAPH.g2o`: SE-Sync with certification.
 
+#include <cstdio>
+#include <iostream>
+
+#include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/internal/json_writer.h"
+#include "ceres_sesync/sesync_solver.h"
+#include "gflags/gflags.h"
 #include "tools/commands.h"
+
+DEFINE_string(tum, "", "solve: also write the poses as a TUM trajectory.");
+DEFINE_string(init, "chordal",
+              "solve: initialization, one of chordal|random|vertices.");
+DECLARE_uint64(seed);  // Defined in generate_command.cc.
+DEFINE_int32(initial_rank, 0, "solve: initial staircase rank (0: d + 2).");
+DEFINE_int32(max_rank, 10, "solve: maximum staircase rank.");
+DEFINE_string(preconditioner, "cholesky",
+              "solve: truncated-CG preconditioner: cholesky|jacobi|none.");
+DEFINE_double(max_time, 0, "solve: wall-clock limit in seconds (0: none).");
 
 namespace ceres_sesync::tools {
 
-// Placeholder until the owning issue lands.
-int RunSolve(const Args&) {
-  std::fputs("ceres_sesync solve: not implemented yet\n", stderr);
-  return kUsageOrInputError;
+int RunSolve(const Args& args) {
+  if (args.size() != 1) {
+    std::fputs("usage: ceres_sesync solve GRAPH.g2o [--output POSES.g2o] "
+               "[--tum FILE] [--json SUMMARY.json] "
+               "[--init chordal|random|vertices] [--verbose]\n",
+               stderr);
+    return kUsageOrInputError;
+  }
+  SolverOptions options;
+  if (FLAGS_init == "chordal") {
+    options.initialization = SolverOptions::Initialization::kChordal;
+  } else if (FLAGS_init == "random") {
+    options.initialization = SolverOptions::Initialization::kRandom;
+  } else if (FLAGS_init == "vertices") {
+    options.initialization = SolverOptions::Initialization::kVertices;
+  } else {
+    std::fprintf(stderr, "ceres_sesync solve: unknown --init '%s'\n",
+                 FLAGS_init.c_str());
+    return kUsageOrInputError;
+  }
+  if (FLAGS_preconditioner == "cholesky") {
+    options.preconditioner = SolverOptions::Preconditioner::kRegularizedCholesky;
+  } else if (FLAGS_preconditioner == "jacobi") {
+    options.preconditioner = SolverOptions::Preconditioner::kBlockJacobi;
+  } else if (FLAGS_preconditioner == "none") {
+    options.preconditioner = SolverOptions::Preconditioner::kNone;
+  } else {
+    std::fprintf(stderr, "ceres_sesync solve: unknown --preconditioner '%s'\n",
+                 FLAGS_preconditioner.c_str());
+    return kUsageOrInputError;
+  }
+  options.seed = FLAGS_seed;
+  options.initial_rank = FLAGS_initial_rank;
+  options.max_rank = FLAGS_max_rank;
+  options.max_time_s = FLAGS_max_time;
+  options.verbose = FLAGS_verbose;
+
+  const std::string& path = args[0];
+  PoseGraph graph;
+  std::string error;
+  G2oReadOptions read_options;
+  if (!ReadG2oFile(path, read_options, &graph, &error)) {
+    std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  if (options.initialization == SolverOptions::Initialization::kVertices &&
+      graph.initial_poses.empty()) {
+    std::fprintf(stderr,
+                 "ceres_sesync solve: %s: --init vertices, but the file has "
+                 "no VERTEX lines\n",
+                 path.c_str());
+    return kUsageOrInputError;
+  }
+  SolverSummary summary;
+  const Poses poses = Solve(graph, options, &summary);
+  std::cout << summary.FullReport() << std::flush;
+  if (summary.status == SolverSummary::Status::kInvalidInput) {
+    std::fprintf(stderr, "ceres_sesync solve: %s: %s\n", path.c_str(),
+                 summary.message.c_str());
+    return kUsageOrInputError;
+  }
+  if (!FLAGS_output.empty() &&
+      !WriteG2oPoses(FLAGS_output, graph, poses, &error)) {
+    std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  if (!FLAGS_tum.empty() && !WriteTumFile(FLAGS_tum, graph, poses, &error)) {
+    std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  if (!FLAGS_json.empty()) {
+    internal::JsonWriter json;
+    json.String("graph", path);
+    json.Int("num_poses", summary.num_poses);
+    json.Int("num_measurements", summary.num_measurements);
+    json.Int("dimension", summary.dimension);
+    json.Number("objective", summary.objective);
+    json.Number("sdp_value", summary.sdp_value);
+    json.Number("lower_bound", summary.lower_bound);
+    json.Number("suboptimality_bound", summary.suboptimality_bound);
+    json.Number("relative_suboptimality_bound",
+                summary.relative_suboptimality_bound);
+    json.Number("rounding_gap", summary.rounding_gap);
+    json.Number("lambda_min", summary.lambda_min_estimate);
+    json.Number("eta", summary.eta);
+    json.Bool("certified", summary.certified());
+    json.Int("rank", summary.final_rank);
+    json.String("status", summary.StatusString());
+    json.Int("iterations", summary.iterations);
+    json.Int("hessian_vector_products", summary.hessian_vector_products);
+    json.BeginObject("time_s");
+    json.Number("data", summary.data_time_s);
+    json.Number("initialization", summary.initialization_time_s);
+    json.Number("optimization", summary.optimization_time_s);
+    json.Number("verification", summary.verification_time_s);
+    json.Number("rounding", summary.rounding_time_s);
+    json.EndObject();
+    json.Number("total_time_s", summary.total_time_s);
+    if (!json.WriteToFile(FLAGS_json, &error)) {
+      std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
+      return kUsageOrInputError;
+    }
+  }
+  return summary.certified() ? kSuccess : kNotCertified;
 }
 
 }  // namespace ceres_sesync::tools

@@ -1,0 +1,50 @@
+// Sparse test of the SE-Sync optimality certificate.
+//
+// For multipliers Lambda (block diagonal, n symmetric d x d blocks) the
+// certificate matrix is S = Q - Lambda (Rosen et al. 2019, Section 5.3). Q is
+// dense, but S + cI is the Schur complement of the positive definite block
+// Lbar in the sparse matrix
+//
+//   K_c = [ Lbar     -Vbar            ]     ((n-1) + dn square),
+//         [ -Vbar^T   D - Lambda + cI ]
+//
+// so S + cI is positive definite if and only if K_c is, and a sparse Cholesky
+// factorization of K_c that succeeds proves lambda_min(S) > -c (up to the
+// floating-point backward error of the factorization, which
+// Factorize() bounds; see BackwardErrorBound()). The same factorization
+// applies (S + cI)^{-1}, which the shift-and-invert eigensolver uses.
+
+#ifndef CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
+#define CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
+
+#include <vector>
+
+#include "ceres_sesync/internal/sesync_problem.h"
+
+namespace ceres_sesync::internal {
+
+class CertificateMatrix {
+ public:
+  explicit CertificateMatrix(const SESyncProblem& problem);
+
+  // Assembles and factorizes K_c for the d x dn multipliers Lambda. Returns
+  // true iff the Cholesky factorization ran to completion.
+  bool Factorize(const Eigen::MatrixXd& Lambda, double c);
+
+  // After a successful Factorize(): x = (S + cI)^{-1} y, y and x in R^{dn}.
+  void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;
+
+  // Dimension dn of S.
+  int dimension() const { return rotation_size_; }
+
+ private:
+  int d_ = 0, n_ = 0, translation_size_ = 0, rotation_size_ = 0;
+  SparseMatrix K_;                   // Lower triangle, pattern fixed.
+  std::vector<double> base_values_;  // K_0 without Lambda.
+  std::vector<int> block_entry_;     // Value index of each (i, a >= b).
+  CholmodFactor factor_;
+};
+
+}  // namespace ceres_sesync::internal
+
+#endif  // CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_

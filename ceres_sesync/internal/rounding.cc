@@ -1,0 +1,44 @@
+#include "ceres_sesync/internal/rounding.h"
+
+#include "Eigen/Eigenvalues"
+#include "Eigen/LU"
+#include "Eigen/SVD"
+
+namespace ceres_sesync::internal {
+
+Eigen::MatrixXd ProjectToRotation(const Eigen::MatrixXd& M) {
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(M,
+                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::MatrixXd U = svd.matrixU();
+  if ((U * svd.matrixV().transpose()).determinant() < 0) {
+    U.col(U.cols() - 1) *= -1;
+  }
+  return U * svd.matrixV().transpose();
+}
+
+Eigen::MatrixXd ProjectBlocksToRotations(const Eigen::MatrixXd& X, int d) {
+  Eigen::MatrixXd R(X.rows(), X.cols());
+  for (int i = 0; i < X.cols() / d; ++i) {
+    R.middleCols(d * i, d) = ProjectToRotation(X.middleCols(d * i, d));
+  }
+  return R;
+}
+
+Eigen::MatrixXd RoundSolution(const Eigen::MatrixXd& Y, int d) {
+  // Y = U S V^T, so S_d V_d^T = U_d^T Y, with U from the r x r Gram matrix.
+  const Eigen::MatrixXd gram = Y * Y.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
+  // Eigenvalues ascend: the top d eigenvectors are the last d columns,
+  // ordered by decreasing singular value.
+  Eigen::MatrixXd Ud = eig.eigenvectors().rightCols(d).rowwise().reverse();
+  Eigen::MatrixXd R = Ud.transpose() * Y;
+  const int n = static_cast<int>(Y.cols() / d);
+  int negative = 0;
+  for (int i = 0; i < n; ++i) {
+    if (R.middleCols(d * i, d).determinant() < 0) ++negative;
+  }
+  if (2 * negative > n) R.row(d - 1) *= -1;
+  return ProjectBlocksToRotations(R, d);
+}
+
+}  // namespace ceres_sesync::internal

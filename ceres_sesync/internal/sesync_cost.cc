@@ -1,0 +1,108 @@
+#include "ceres_sesync/internal/sesync_cost.h"
+
+#include <cmath>
+#include <vector>
+
+#include "Eigen/Cholesky"
+#include "ceres_sesync/stiefel_manifold.h"
+#include "glog/logging.h"
+
+namespace ceres_sesync::internal {
+
+SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
+                                           PreconditionerType type,
+                                           double max_condition)
+    : d_(problem.dimension()), type_(type) {
+  if (type == PreconditionerType::kNone) return;
+  const SparseMatrix& D = problem.D();
+  // Gershgorin bound on lambda_max(D).
+  Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(D.rows());
+  for (int k = 0; k < D.outerSize(); ++k) {
+    for (SparseMatrix::InnerIterator it(D, k); it; ++it) {
+      row_sums(it.row()) += std::abs(it.value());
+    }
+  }
+  const double eps = row_sums.maxCoeff() / max_condition;
+  const int d = d_, n = problem.num_poses();
+  if (type == PreconditionerType::kBlockJacobi) {
+    block_inverses_.resize(d, d * n);
+    const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(d, d);
+    for (int i = 0; i < n; ++i) {
+      Eigen::MatrixXd block =
+          Eigen::MatrixXd(D.block(d * i, d * i, d, d)) + eps * identity;
+      block_inverses_.middleCols(d * i, d) = block.llt().solve(identity);
+    }
+    return;
+  }
+  SparseMatrix regularized = D;
+  for (int k = 0; k < regularized.rows(); ++k) {
+    regularized.coeffRef(k, k) += eps;
+  }
+  factor_ = std::make_unique<CholmodFactor>();
+  QuietCholmod(factor_.get());
+  factor_->compute(regularized);
+  CHECK(factor_->info() == Eigen::Success)
+      << "regularized Cholesky preconditioner failed";
+}
+
+void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
+                                 Eigen::MatrixXd* X) const {
+  switch (type_) {
+    case PreconditionerType::kNone:
+      *X = V;
+      return;
+    case PreconditionerType::kBlockJacobi:
+      BlockDiagonalMultiply(V, block_inverses_, d_, X);
+      return;
+    case PreconditionerType::kRegularizedCholesky:
+      *X = factor_->solve(V.transpose()).transpose();
+      return;
+  }
+}
+
+SESyncCost::SESyncCost(const SESyncProblem* problem,
+                       const SESyncPreconditioner* preconditioner)
+    : problem_(problem),
+      preconditioner_(preconditioner),
+      d_(problem->dimension()) {}
+
+double SESyncCost::Evaluate(const Eigen::MatrixXd& Y) {
+  Y_ = Y;
+  problem_->MultiplyQ(Y_, &YQ_);
+  lambda_ = SymBlockDiagProduct(YQ_, Y_, d_);
+  return Y_.cwiseProduct(YQ_).sum();
+}
+
+void SESyncCost::Gradient(Eigen::MatrixXd* gradient) {
+  // Proj_Y(2 Y Q) = 2 (Y Q - Y_i Lambda_i), eq. (43).
+  BlockDiagonalMultiply(Y_, lambda_, d_, gradient);
+  *gradient = 2 * (YQ_ - *gradient);
+}
+
+void SESyncCost::HessianVector(const Eigen::MatrixXd& V,
+                               Eigen::MatrixXd* hv) {
+  // Eq. (44): Proj_Y(2 V Q - V_i SymBlockDiag(Y^T 2 Y Q)_i).
+  ++hessian_vector_products_;
+  Eigen::MatrixXd VQ, V_lambda;
+  problem_->MultiplyQ(V, &VQ);
+  BlockDiagonalMultiply(V, lambda_, d_, &V_lambda);
+  ProjectToStiefelProductTangent(Y_, 2 * (VQ - V_lambda), d_, hv);
+}
+
+void SESyncCost::Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) {
+  Eigen::MatrixXd X;
+  preconditioner_->Apply(V, &X);
+  ProjectToStiefelProductTangent(Y_, X, d_, pv);
+}
+
+void SESyncCost::Retract(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,
+                         Eigen::MatrixXd* result) {
+  RetractStiefelProduct(Y, V, d_, result);
+}
+
+void SESyncCost::ProjectToTangent(const Eigen::MatrixXd& V,
+                                  Eigen::MatrixXd* result) {
+  ProjectToStiefelProductTangent(Y_, V, d_, result);
+}
+
+}  // namespace ceres_sesync::internal

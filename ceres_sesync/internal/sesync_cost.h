@@ -1,0 +1,64 @@
+// The Burer-Monteiro cost F(Y) = tr(Q Y^T Y) on St(d, r)^n (Rosen et al. 2019,
+// Problem 9) with its Riemannian gradient (43), Hessian (44) and
+// preconditioners, as a RiemannianCostFunction.
+
+#ifndef CERES_SESYNC_INTERNAL_SESYNC_COST_H_
+#define CERES_SESYNC_INTERNAL_SESYNC_COST_H_
+
+#include <memory>
+
+#include "ceres_sesync/internal/sesync_problem.h"
+#include "ceres_sesync/riemannian_trust_region.h"
+
+namespace ceres_sesync::internal {
+
+enum class PreconditionerType { kNone, kBlockJacobi, kRegularizedCholesky };
+
+// Approximate inverse of D = L(G^rho) + Sigma~ (the sparse part of Q),
+// regularized as D + (lambda_max(D) / max_condition) I.
+class SESyncPreconditioner {
+ public:
+  SESyncPreconditioner(const SESyncProblem& problem, PreconditionerType type,
+                       double max_condition);
+  // X = V (D + eps I)^{-1} (or the block-Jacobi version); V is r x dn.
+  void Apply(const Eigen::MatrixXd& V, Eigen::MatrixXd* X) const;
+  PreconditionerType type() const { return type_; }
+
+ private:
+  int d_;
+  PreconditionerType type_;
+  Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.
+  std::unique_ptr<CholmodFactor> factor_;
+};
+
+class SESyncCost : public RiemannianCostFunction {
+ public:
+  // Both must outlive this object.
+  SESyncCost(const SESyncProblem* problem,
+             const SESyncPreconditioner* preconditioner);
+
+  double Evaluate(const Eigen::MatrixXd& Y) override;
+  void Gradient(Eigen::MatrixXd* gradient) override;
+  void HessianVector(const Eigen::MatrixXd& V, Eigen::MatrixXd* hv) override;
+  void Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) override;
+  void Retract(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,
+               Eigen::MatrixXd* result) override;
+  void ProjectToTangent(const Eigen::MatrixXd& V,
+                        Eigen::MatrixXd* result) override;
+
+  // Lagrange multipliers Lambda = SymBlockDiag_d(Q Y^T Y) (d x dn) at the
+  // current point.
+  const Eigen::MatrixXd& Lambda() const { return lambda_; }
+  int hessian_vector_products() const { return hessian_vector_products_; }
+
+ private:
+  const SESyncProblem* problem_;
+  const SESyncPreconditioner* preconditioner_;
+  int d_;
+  Eigen::MatrixXd Y_, YQ_, lambda_;
+  int hessian_vector_products_ = 0;
+};
+
+}  // namespace ceres_sesync::internal
+
+#endif  // CERES_SESYNC_INTERNAL_SESYNC_COST_H_

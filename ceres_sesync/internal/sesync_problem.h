@@ -1,0 +1,75 @@
+// The data matrices of the SE-Sync rotation-only problem (Rosen et al., IJRR
+// 2019, Problem 4 / eq. 24) in the translation-eliminated form, built once from
+// a validated PoseGraph in O(m) memory.
+//
+// With R = [R_1 ... R_n] (d x dn) and translations T = [t_1 ... t_n] (d x n),
+// the objective (12) is tr([T R] M [T R]^T) with the sparse
+//
+//   M = [ L(W^tau)   -V ]     L(W^tau): translational weight Laplacian (n x n)
+//       [ -V^T        D ],    D = L(G^rho) + Sigma~ (dn x dn), V (n x dn).
+//
+// Fixing t_0 = 0 (the objective is translation invariant) and eliminating the
+// translations gives Q = D - Vbar^T Lbar^{-1} Vbar, where Lbar and Vbar drop
+// the first row (and column) of L(W^tau) and V. Q itself is dense; products
+// Y Q cost O(m r) through one sparse Cholesky factorization of Lbar (eq. 39).
+
+#ifndef CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
+#define CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
+
+#include <memory>
+
+#include "Eigen/CholmodSupport"
+#include "Eigen/Core"
+#include "Eigen/SparseCore"
+#include "ceres_sesync/pose_graph.h"
+
+namespace ceres_sesync::internal {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using CholmodFactor = Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>;
+
+// Silences CHOLMOD's own printing (failures are reported through info()).
+void QuietCholmod(CholmodFactor* factor);
+
+class SESyncProblem {
+ public:
+  // `graph` must pass ValidatePoseGraph. Check ok() afterwards: it fails only
+  // if the translational Laplacian could not be factorized.
+  explicit SESyncProblem(const PoseGraph& graph);
+
+  bool ok() const { return ok_; }
+  int dimension() const { return d_; }
+  int num_poses() const { return n_; }
+
+  // YQ = Y * Q for Y of size r x dn. O(m r) plus one Cholesky solve.
+  void MultiplyQ(const Eigen::MatrixXd& Y, Eigen::MatrixXd* YQ) const;
+
+  // Optimal translations (d x n, eq. 21) for the rotations R (d x dn), with
+  // t_0 = 0.
+  Eigen::MatrixXd RecoverTranslations(const Eigen::MatrixXd& R) const;
+
+  // D = L(G^rho) + Sigma~ (dn x dn, both triangles stored).
+  const SparseMatrix& D() const { return D_; }
+  // Vbar: V without its first row ((n-1) x dn).
+  const SparseMatrix& Vbar() const { return Vbar_; }
+  // Lbar: L(W^tau) without its first row and column (lower triangle stored).
+  const SparseMatrix& Lbar() const { return Lbar_; }
+  // The rotational connection Laplacian L(G^rho) alone (dn x dn).
+  const SparseMatrix& RotationLaplacian() const { return Lrho_; }
+
+ private:
+  int d_ = 0, n_ = 0;
+  bool ok_ = false;
+  SparseMatrix D_, Lrho_, Vbar_, VbarT_, Lbar_;
+  std::unique_ptr<CholmodFactor> lbar_factor_;
+};
+
+// out_i = V_i * Lambda_i for the d x d blocks Lambda (d x dn) and the r x d
+// blocks V_i of V (r x dn).
+void BlockDiagonalMultiply(const Eigen::MatrixXd& V,
+                           const Eigen::MatrixXd& Lambda, int d,
+                           Eigen::MatrixXd* out);
+
+}  // namespace ceres_sesync::internal
+
+#endif  // CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_

@@ -1,0 +1,123 @@
+#include "ceres_sesync/internal/verification.h"
+
+#include <cmath>
+#include <limits>
+
+#include "Eigen/Eigenvalues"
+#include "Spectra/SymEigsSolver.h"
+#include "glog/logging.h"
+
+namespace ceres_sesync::internal {
+namespace {
+
+// y = (S + cI)^{-1} x through the factorized K_c, for Spectra.
+class ShiftInvertOperator {
+ public:
+  using Scalar = double;
+  explicit ShiftInvertOperator(const CertificateMatrix* matrix)
+      : matrix_(matrix) {}
+  Eigen::Index rows() const { return matrix_->dimension(); }
+  Eigen::Index cols() const { return matrix_->dimension(); }
+  void perform_op(const double* x_in, double* y_out) const {
+    Eigen::VectorXd y;
+    matrix_->SolveShifted(
+        Eigen::Map<const Eigen::VectorXd>(x_in, matrix_->dimension()), &y);
+    Eigen::Map<Eigen::VectorXd>(y_out, y.size()) = y;
+  }
+
+ private:
+  const CertificateMatrix* matrix_;
+};
+
+double MaxBlockEigenvalue(const Eigen::MatrixXd& Lambda, int d) {
+  double lambda_max = 0;
+  for (int i = 0; i < Lambda.cols() / d; ++i) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(
+        Lambda.middleCols(d * i, d), Eigen::EigenvaluesOnly);
+    lambda_max = std::max(lambda_max, eig.eigenvalues().maxCoeff());
+  }
+  return lambda_max;
+}
+
+}  // namespace
+
+Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
+                                    const Eigen::MatrixXd& Lambda,
+                                    const Eigen::VectorXd& v) {
+  const int d = problem.dimension();
+  Eigen::MatrixXd vq;
+  problem.MultiplyQ(v.transpose(), &vq);
+  Eigen::MatrixXd v_lambda;
+  BlockDiagonalMultiply(v.transpose(), Lambda, d, &v_lambda);
+  return (vq - v_lambda).transpose();
+}
+
+VerificationResult VerifyCertificate(const SESyncProblem& problem,
+                                     const Eigen::MatrixXd& Lambda,
+                                     double eta_target, double eta_max,
+                                     CertificateMatrix* matrix) {
+  VerificationResult result;
+  result.lambda_min_estimate = std::numeric_limits<double>::quiet_NaN();
+  const int d = problem.dimension();
+  ++result.factorizations;
+  if (matrix->Factorize(Lambda, eta_target)) {
+    result.certified = true;
+    result.eta = eta_target;
+    return result;
+  }
+  // Bracket lambda_min(S) from below: S + cI is PD for c > lambda_max(Lambda).
+  const double c_upper = 1.01 * MaxBlockEigenvalue(Lambda, d) + eta_target;
+  double c = eta_target;
+  bool proven = false;
+  while (c < c_upper) {
+    c = std::min(16 * c, c_upper);
+    ++result.factorizations;
+    if (matrix->Factorize(Lambda, c)) {
+      proven = true;
+      break;
+    }
+  }
+  if (!proven) {
+    // Only round-off can make this fail; report it as an eigen failure.
+    result.eta = std::numeric_limits<double>::infinity();
+    result.eigensolver_failed = true;
+    return result;
+  }
+  result.eta = c;
+  // lambda_min(S) > -c: the largest eigenvalue of (S + cI)^{-1} is
+  // 1 / (lambda_min + c).
+  ShiftInvertOperator op(matrix);
+  const int dim = matrix->dimension();
+  Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1,
+                                                   std::min(20, dim));
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-8);
+  if (eigs.info() == Spectra::CompInfo::Successful) {
+    const double mu = eigs.eigenvalues()(0);
+    result.lambda_min_estimate = 1.0 / mu - c;
+    result.direction = eigs.eigenvectors().col(0).normalized();
+  } else {
+    LOG(WARNING) << "shift-and-invert Lanczos did not converge";
+  }
+  if (result.direction.size() == dim) {
+    result.direction_curvature =
+        result.direction.dot(MultiplyCertificate(problem, Lambda, result.direction));
+  }
+  if (c <= eta_max) {
+    // Within tolerance: tighten the slack to just above the estimate.
+    result.certified = true;
+    if (std::isfinite(result.lambda_min_estimate)) {
+      const double tight =
+          std::max(eta_target, -1.05 * result.lambda_min_estimate);
+      ++result.factorizations;
+      if (tight < c && matrix->Factorize(Lambda, tight)) result.eta = tight;
+    }
+    return result;
+  }
+  if (result.direction.size() != dim || !(result.direction_curvature < 0)) {
+    result.eigensolver_failed = true;
+  }
+  return result;
+}
+
+}  // namespace ceres_sesync::internal

@@ -1,0 +1,198 @@
+#include "ceres_sesync/riemannian_trust_region.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace ceres_sesync {
+namespace {
+
+double Inner(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.cwiseProduct(b).sum();
+}
+
+struct TcgResult {
+  Eigen::MatrixXd eta;     // The step.
+  Eigen::MatrixXd h_eta;   // Hessian times the step.
+  int iterations = 0;
+  bool hit_boundary = false;
+};
+
+// Preconditioned Steihaug-Toint truncated CG for min <g, eta> + 1/2 <H eta,
+// eta> subject to <eta, P^{-1} eta> <= radius^2.
+TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
+                      RiemannianCostFunction* cost, const Eigen::MatrixXd& g,
+                      double radius) {
+  TcgResult out;
+  out.eta.setZero(g.rows(), g.cols());
+  out.h_eta.setZero(g.rows(), g.cols());
+  Eigen::MatrixXd r = g, z, delta, h_delta;
+  cost->Precondition(r, &z);
+  double z_r = Inner(z, r);
+  delta = -z;
+  double e_pe = 0, e_pd = 0, d_pd = z_r;
+  const double r0 = std::sqrt(Inner(r, r));
+  const double target =
+      r0 * std::min(std::pow(r0, options.tcg_theta), options.tcg_kappa);
+  const double radius2 = radius * radius;
+  for (int j = 0; j < options.max_inner_iterations; ++j) {
+    cost->HessianVector(delta, &h_delta);
+    ++out.iterations;
+    const double d_hd = Inner(delta, h_delta);
+    const double alpha = z_r / d_hd;
+    const double e_pe_new = e_pe + 2 * alpha * e_pd + alpha * alpha * d_pd;
+    if (d_hd <= 0 || e_pe_new >= radius2 || !std::isfinite(alpha)) {
+      // Move to the boundary along delta.
+      const double tau =
+          (-e_pd + std::sqrt(std::max(0.0, e_pd * e_pd +
+                                               d_pd * (radius2 - e_pe)))) /
+          d_pd;
+      out.eta += tau * delta;
+      out.h_eta += tau * h_delta;
+      out.hit_boundary = true;
+      return out;
+    }
+    out.eta += alpha * delta;
+    out.h_eta += alpha * h_delta;
+    e_pe = e_pe_new;
+    r += alpha * h_delta;
+    cost->ProjectToTangent(Eigen::MatrixXd(r), &r);
+    if (std::sqrt(Inner(r, r)) <= target) return out;
+    cost->Precondition(r, &z);
+    const double z_r_old = z_r;
+    z_r = Inner(z, r);
+    const double beta = z_r / z_r_old;
+    delta = beta * delta - z;
+    e_pd = beta * (e_pd + alpha * d_pd);
+    d_pd = z_r + beta * beta * d_pd;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string RiemannianTrustRegionSummary::TerminationString() const {
+  switch (termination) {
+    case Termination::kGradientTolerance:
+      return "gradient tolerance";
+    case Termination::kPreconditionedGradientTolerance:
+      return "preconditioned gradient tolerance";
+    case Termination::kRelativeDecrease:
+      return "relative decrease tolerance";
+    case Termination::kStepTolerance:
+      return "step tolerance";
+    case Termination::kMaxIterations:
+      return "maximum iterations";
+    case Termination::kMaxTime:
+      return "time limit";
+    case Termination::kUserCallback:
+      return "stopped by callback";
+    case Termination::kNonFinite:
+      return "non-finite cost";
+  }
+  return "unknown";
+}
+
+void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
+                                   RiemannianCostFunction* cost,
+                                   Eigen::MatrixXd* x,
+                                   RiemannianTrustRegionSummary* summary) {
+  using Clock = std::chrono::steady_clock;
+  using Termination = RiemannianTrustRegionSummary::Termination;
+  const auto start = Clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  *summary = RiemannianTrustRegionSummary();
+  double f = cost->Evaluate(*x);
+  summary->initial_cost = f;
+  Eigen::MatrixXd g, pg, x_new;
+  double radius = options.initial_trust_radius;
+  auto finish = [&](Termination t) {
+    summary->termination = t;
+    summary->final_cost = f;
+    summary->time_s = elapsed();
+  };
+  for (int k = 0;; ++k) {
+    cost->Gradient(&g);
+    cost->Precondition(g, &pg);
+    const double g_norm = std::sqrt(Inner(g, g));
+    const double pg_norm = std::sqrt(std::max(0.0, Inner(g, pg)));
+    summary->final_gradient_norm = g_norm;
+    summary->final_preconditioned_gradient_norm = pg_norm;
+    if (!std::isfinite(f) || !std::isfinite(g_norm)) {
+      return finish(Termination::kNonFinite);
+    }
+    if (g_norm <= options.gradient_tolerance) {
+      return finish(Termination::kGradientTolerance);
+    }
+    if (pg_norm <= options.preconditioned_gradient_tolerance) {
+      return finish(Termination::kPreconditionedGradientTolerance);
+    }
+    if (k >= options.max_iterations) return finish(Termination::kMaxIterations);
+    if (options.max_time_s > 0 && elapsed() >= options.max_time_s) {
+      return finish(Termination::kMaxTime);
+    }
+    if (radius <= 0) {
+      // Initial radius: the length (in the P^{-1} norm) of the preconditioned
+      // steepest-descent step -P g, a scale-free choice.
+      radius = pg_norm;
+    }
+    // Inner solve, then shrink the radius until a step is accepted.
+    for (;;) {
+      const TcgResult step = TruncatedCg(options, cost, g, radius);
+      summary->hessian_vector_products += step.iterations;
+      const double model_decrease =
+          -(Inner(g, step.eta) + 0.5 * Inner(step.eta, step.h_eta));
+      cost->Retract(*x, step.eta, &x_new);
+      const double f_new = cost->Evaluate(x_new);
+      const double actual_decrease = f - f_new;
+      // rho with a small safeguard against round-off when both are tiny.
+      const double eps = 1e-14 * std::max(1.0, std::abs(f));
+      const double rho =
+          (actual_decrease + eps) / (std::max(model_decrease, 0.0) + eps);
+      if (rho < 0.25) {
+        radius *= 0.25;
+      } else if (rho > 0.75 && step.hit_boundary) {
+        radius *= 2;
+      }
+      const double step_norm = std::sqrt(Inner(step.eta, step.eta));
+      if (rho > 0.1 && std::isfinite(f_new) && f_new <= f) {
+        const double decrease = f - f_new;
+        *x = x_new;
+        f = f_new;
+        summary->iterations = k + 1;
+        if (options.callback &&
+            !options.callback(k + 1, f, g_norm, radius, step.iterations)) {
+          cost->Gradient(&g);
+          summary->final_gradient_norm = std::sqrt(Inner(g, g));
+          return finish(Termination::kUserCallback);
+        }
+        if (decrease <= options.relative_decrease_tolerance * std::abs(f) ||
+            step_norm <= options.step_tolerance) {
+          cost->Gradient(&g);
+          cost->Precondition(g, &pg);
+          summary->final_gradient_norm = std::sqrt(Inner(g, g));
+          summary->final_preconditioned_gradient_norm =
+              std::sqrt(std::max(0.0, Inner(g, pg)));
+          return finish(decrease <= options.relative_decrease_tolerance *
+                                        std::abs(f)
+                            ? Termination::kRelativeDecrease
+                            : Termination::kStepTolerance);
+        }
+        break;
+      }
+      // Rejected: restore the current point in the cost function.
+      cost->Evaluate(*x);
+      if (step_norm <= options.step_tolerance || radius <= 1e-300) {
+        summary->iterations = k + 1;
+        return finish(Termination::kStepTolerance);
+      }
+      if (options.max_time_s > 0 && elapsed() >= options.max_time_s) {
+        return finish(Termination::kMaxTime);
+      }
+    }
+  }
+}
+
+}  // namespace ceres_sesync

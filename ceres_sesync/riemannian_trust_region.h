@@ -1,0 +1,103 @@
+// A truncated-Newton Riemannian trust-region method (RTR; Absil, Baker and
+// Gallivan 2007) with a Steihaug-Toint truncated conjugate-gradient inner
+// solver and an optional preconditioner, for any smooth cost on a matrix
+// manifold with the Frobenius metric. SE-Sync uses it on St(d, r)^n (Rosen et
+// al. 2019, Algorithm 1), but nothing here is specific to SE-Sync.
+
+#ifndef CERES_SESYNC_RIEMANNIAN_TRUST_REGION_H_
+#define CERES_SESYNC_RIEMANNIAN_TRUST_REGION_H_
+
+#include <functional>
+#include <string>
+
+#include "Eigen/Core"
+
+namespace ceres_sesync {
+
+// The cost and manifold geometry seen by the solver. Points and tangent
+// vectors are matrices of the same shape; the metric is <A, B> = tr(A^T B).
+class RiemannianCostFunction {
+ public:
+  virtual ~RiemannianCostFunction() = default;
+  // Evaluates f(x) and makes x the current point: Gradient(),
+  // HessianVector() and Precondition() refer to the last evaluated point.
+  virtual double Evaluate(const Eigen::MatrixXd& x) = 0;
+  // Riemannian gradient at the current point.
+  virtual void Gradient(Eigen::MatrixXd* gradient) = 0;
+  // Riemannian Hessian at the current point applied to the tangent vector v.
+  virtual void HessianVector(const Eigen::MatrixXd& v,
+                             Eigen::MatrixXd* hv) = 0;
+  // Applies a symmetric positive definite preconditioner (an approximation of
+  // the inverse Hessian) to the tangent vector v; the result must be tangent.
+  // The default is the identity.
+  virtual void Precondition(const Eigen::MatrixXd& v, Eigen::MatrixXd* pv) {
+    *pv = v;
+  }
+  // Retraction: the point reached from x along the tangent vector v.
+  virtual void Retract(const Eigen::MatrixXd& x, const Eigen::MatrixXd& v,
+                       Eigen::MatrixXd* result) = 0;
+  // Orthogonal projection of v onto the tangent space at the current point
+  // (used to suppress round-off drift in the inner solver).
+  virtual void ProjectToTangent(const Eigen::MatrixXd& v,
+                                Eigen::MatrixXd* result) = 0;
+};
+
+struct RiemannianTrustRegionOptions {
+  // Maximum number of outer (trust-region) iterations; the paper's value.
+  int max_iterations = 1000;
+  // Maximum number of Hessian-vector products per truncated-CG solve.
+  int max_inner_iterations = 10000;
+  // Stop when ||grad f|| <= gradient_tolerance.
+  double gradient_tolerance = 1e-6;
+  // Stop when sqrt(<grad f, P grad f>) <= preconditioned_gradient_tolerance
+  // (P the preconditioner).
+  double preconditioned_gradient_tolerance = 1e-6;
+  // Stop when an accepted step decreases f by less than this fraction of |f|.
+  double relative_decrease_tolerance = 1e-12;
+  // Stop when an accepted step has norm below this.
+  double step_tolerance = 1e-10;
+  // Initial trust radius (in the preconditioner's norm); <= 0 means "from the
+  // first Cauchy step".
+  double initial_trust_radius = -1;
+  // Truncated-CG stopping: ||r|| <= ||r0|| min(||r0||^theta, kappa).
+  double tcg_kappa = 0.1;
+  double tcg_theta = 1.0;
+  // Wall-clock limit in seconds (<= 0: none).
+  double max_time_s = 0;
+  // Called after every outer iteration; return false to stop.
+  std::function<bool(int iteration, double f, double gradient_norm,
+                     double trust_radius, int inner_iterations)>
+      callback;
+};
+
+struct RiemannianTrustRegionSummary {
+  enum class Termination {
+    kGradientTolerance,
+    kPreconditionedGradientTolerance,
+    kRelativeDecrease,
+    kStepTolerance,
+    kMaxIterations,
+    kMaxTime,
+    kUserCallback,
+    kNonFinite,
+  };
+  Termination termination = Termination::kMaxIterations;
+  int iterations = 0;
+  int hessian_vector_products = 0;
+  double initial_cost = 0;
+  double final_cost = 0;
+  double final_gradient_norm = 0;
+  double final_preconditioned_gradient_norm = 0;
+  double time_s = 0;
+  std::string TerminationString() const;
+};
+
+// Minimizes the cost from `x` (overwritten with the result).
+void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
+                                   RiemannianCostFunction* cost,
+                                   Eigen::MatrixXd* x,
+                                   RiemannianTrustRegionSummary* summary);
+
+}  // namespace ceres_sesync
+
+#endif  // CERES_SESYNC_RIEMANNIAN_TRUST_REGION_H_

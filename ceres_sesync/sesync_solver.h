@@ -1,0 +1,149 @@
+// SE-Sync: certifiably correct pose-graph optimization (Rosen, Carlone,
+// Bandeira, Leonard, "SE-Sync: A certifiably correct algorithm for
+// synchronization over the special Euclidean group", IJRR 2019).
+//
+//   ceres_sesync::SolverOptions options;
+//   ceres_sesync::SolverSummary summary;
+//   ceres_sesync::Poses poses = ceres_sesync::Solve(graph, options, &summary);
+//   std::cout << summary.FullReport() << "\n";
+//   if (summary.certified()) { ... poses are a global optimum ... }
+//
+// The solver runs the Riemannian staircase (Algorithm 1): it minimizes the
+// Burer-Monteiro cost tr(Q Y^T Y) over St(d, r)^n with a truncated-Newton
+// Riemannian trust-region method, checks the optimality certificate
+// S = Q - Lambda with a sparse Cholesky factorization, escapes saddle points
+// along negative curvature to rank r + 1, and finally rounds Y to SO(d)^n
+// (Algorithm 2) and recovers the translations (eq. 21).
+
+#ifndef CERES_SESYNC_SESYNC_SOLVER_H_
+#define CERES_SESYNC_SESYNC_SOLVER_H_
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "ceres_sesync/pose_graph.h"
+
+namespace ceres_sesync {
+
+struct SolverOptions {
+  enum class Initialization {
+    kChordal,   // Chordal relaxation (one sparse solve). Recommended.
+    kRandom,    // A uniformly random point of St(d, r0)^n.
+    kVertices,  // The graph's own initial_poses (from VERTEX lines).
+  };
+  enum class Preconditioner { kNone, kBlockJacobi, kRegularizedCholesky };
+
+  // How the staircase is started. Solve(graph, initial, ...) overrides this.
+  Initialization initialization = Initialization::kChordal;
+  // Seed for kRandom (results are deterministic for a seed).
+  uint64_t seed = 0;
+  // Initial rank r0 of the staircase; 0 means d + 2. Must be >= d + 1 if set.
+  int initial_rank = 0;
+  // Largest rank tried before giving up with kMaxRankReached.
+  int max_rank = 10;
+
+  // Preconditioner of the truncated CG inner solver, and the condition number
+  // cap of the regularized Cholesky one (D + (lambda_max(D)/cap) I).
+  Preconditioner preconditioner = Preconditioner::kRegularizedCholesky;
+  double regularized_cholesky_max_condition = 1e6;
+
+  // Local optimization at each rank (Riemannian trust region): the paper's
+  // iteration limits.
+  int max_iterations = 1000;
+  int max_inner_iterations = 10000;
+  // Stop when the preconditioned gradient norm sqrt(<g, P g>) falls below
+  // this fraction of sqrt(F(Y)) (scale-free; F has units of the weights).
+  double relative_preconditioned_gradient_tolerance = 1e-9;
+  // Stop when an accepted step decreases F by less than this fraction of F.
+  double relative_decrease_tolerance = 1e-15;
+
+  // Certification. S + eta I is tested with eta = eta_target, where
+  // eta_target is the shift whose bound eta d n equals
+  // `certification_target_relative_bound` * F(Y); the solution is declared
+  // certified if a shift giving a relative bound of at most
+  // `certification_max_relative_bound` is proven.
+  double certification_target_relative_bound = 1e-9;
+  double certification_max_relative_bound = 1e-6;
+  // Absolute floor on eta relative to max diag(Q's sparse part) (matters for
+  // noiseless data where F(Y) = 0).
+  double min_relative_eta = 1e-12;
+
+  // Wall-clock limit for the whole solve (<= 0: none).
+  double max_time_s = 0;
+  // Log progress (rank, iteration, F, gradient norm, trust radius) via glog.
+  bool verbose = false;
+  // Optional per-iteration callback (rank, iteration, F, gradient norm,
+  // trust radius); return false to stop the current level.
+  std::function<bool(int rank, int iteration, double f, double gradient_norm,
+                     double trust_radius)>
+      callback;
+};
+
+struct SolverSummary {
+  enum class Status {
+    kCertifiedOptimum,      // S + eta I proven PD: a global optimum.
+    kSaddleNotEscaped,      // Negative curvature found, no descent along it.
+    kEigenImprecision,      // The eigensolver found no negative curvature.
+    kMaxRankReached,        // Not certified at max_rank.
+    kTimeLimit,             // max_time_s reached.
+    kInvalidInput,          // The graph failed validation; see message.
+  };
+  struct Level {
+    int rank = 0;
+    int iterations = 0;
+    int hessian_vector_products = 0;
+    double sdp_value = 0;  // F(Y) at the end of the level.
+    double gradient_norm = 0;
+    std::string termination;
+    bool certified = false;
+    double eta = 0;
+    double lambda_min_estimate = 0;
+    double optimize_time_s = 0;
+    double verify_time_s = 0;
+  };
+
+  Status status = Status::kInvalidInput;
+  std::string message;  // Error text for kInvalidInput.
+  int dimension = 0, num_poses = 0, num_measurements = 0;
+  // F(x) of eq. (12) at the returned poses.
+  double objective = 0;
+  // F(Y) = tr(Q Y^T Y) at the final factor Y (the SDP relaxation's value there).
+  double sdp_value = 0;
+  // Proven lower bound on the optimal value: F(Y) - eta d n.
+  double lower_bound = 0;
+  // (objective - lower_bound) and its ratio to lower_bound.
+  double suboptimality_bound = 0;
+  double relative_suboptimality_bound = 0;
+  // Relative rounding gap (F(x) - F(Y)) / F(Y).
+  double rounding_gap = 0;
+  double lambda_min_estimate = 0;  // NaN when no eigensolve was needed.
+  double eta = 0;                  // Shift proven for S + eta I.
+  int final_rank = 0;
+  int iterations = 0;
+  int hessian_vector_products = 0;
+  int factorizations = 0;  // Cholesky factorizations in verification.
+  std::vector<Level> levels;
+  // Wall-clock seconds per stage.
+  double data_time_s = 0, initialization_time_s = 0, optimization_time_s = 0,
+         verification_time_s = 0, rounding_time_s = 0, total_time_s = 0;
+
+  bool certified() const { return status == Status::kCertifiedOptimum; }
+  std::string StatusString() const;
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+// Solves the pose graph; the initialization comes from options.
+Poses Solve(const PoseGraph& graph, const SolverOptions& options,
+            SolverSummary* summary);
+
+// Solves the pose graph starting from the given poses (their rotations are
+// projected to SO(d)); options.initialization is ignored.
+Poses Solve(const PoseGraph& graph, const Poses& initial,
+            const SolverOptions& options, SolverSummary* summary);
+
+}  // namespace ceres_sesync
+
+#endif  // CERES_SESYNC_SESYNC_SOLVER_H_
