@@ -1,0 +1,134 @@
+// Local-search baselines: the maximum-likelihood objective (12) of Rosen et
+// al. (IJRR 2019),
+//
+//   F(x) = sum_(i,j) kappa_ij ||R_j - R_i R~_ij||_F^2
+//                  + tau_ij   ||t_j - t_i - R_i t~_ij||_2^2,
+//
+// minimized directly by Ceres (Levenberg-Marquardt, or Powell's dogleg with
+// the Gauss-Newton model, the paper's PDL-GN baseline). These find a local
+// minimum only; nothing certifies it.
+//
+// Ceres minimizes 0.5 * sum ||r||^2, so with the residuals used here F = 2 *
+// Ceres cost. Parametrization:
+//  - d = 2: per pose a translation block (x, y) and an angle block (theta),
+//    R(theta) = [cos -sin; sin cos]; residual (6 entries)
+//      [sqrt(kappa) vec(R(theta_j) - R(theta_i) R~);
+//       sqrt(tau) (t_j - t_i - R(theta_i) t~)].
+//  - d = 3: per pose a translation block (3) and an Eigen quaternion block
+//    (x, y, z, w) on ceres::EigenQuaternionManifold; residual (12 entries)
+//    with vec(R(q_j) - R(q_i) R~) (9) and the translation term (3).
+// Jacobians by automatic differentiation.
+
+#ifndef CERES_SESYNC_CERES_BASELINE_H_
+#define CERES_SESYNC_CERES_BASELINE_H_
+
+#include <string>
+#include <vector>
+
+#include "ceres/problem.h"
+#include "ceres/solver.h"
+#include "ceres_sesync/pose_graph.h"
+
+namespace ceres_sesync {
+
+struct CeresBaselineOptions {
+  enum class Method {
+    // ceres::LEVENBERG_MARQUARDT trust region.
+    kLevenbergMarquardt,
+    // ceres::DOGLEG with TRADITIONAL_DOGLEG: Powell's dogleg with the
+    // Gauss-Newton model (the paper's PDL-GN baseline).
+    kPowellDogleg,
+  };
+  Method method = Method::kPowellDogleg;
+  // Stop when |F_old - F_new| / F_old < function_tolerance (the paper's
+  // relative-decrease criterion, 1e-6).
+  double function_tolerance = 1e-6;
+  // Stop when max_i |x_i - Plus(x_i, -grad_i)| < gradient_tolerance (Ceres's
+  // default 1e-10).
+  double gradient_tolerance = 1e-10;
+  // Stop when |step| < parameter_tolerance * (|x| + parameter_tolerance)
+  // (Ceres's default 1e-8).
+  double parameter_tolerance = 1e-8;
+  // Maximum number of iterations (the paper's limit: 1000).
+  int max_num_iterations = 1000;
+  // Wall-clock limit of the solve, in seconds.
+  double max_solver_time_s = 1e9;
+  // Threads for Jacobian evaluation and the linear solver.
+  int num_threads = 1;
+  // Log per-iteration progress to stdout (Ceres's minimizer_progress_to_
+  // stdout).
+  bool verbose = false;
+};
+
+struct CeresBaselineSummary {
+  // Ceres's own summary of the solve.
+  ceres::Solver::Summary solver_summary;
+  // F at the initial poses, on the scale of eq. (12) (= 2 * Ceres cost).
+  double initial_objective = 0;
+  // F at the returned poses, on the scale of eq. (12).
+  double final_objective = 0;
+  // Number of trust-region iterations (successful + unsuccessful steps).
+  int iterations = 0;
+  // Wall time of ceres::Solve, in seconds.
+  double time_s = 0;
+  // One line: method, objectives, iterations, time, termination.
+  std::string BriefReport() const;
+};
+
+// Parameter storage of a pose graph in the form Ceres optimizes (see the top
+// of this file): translations (d per pose) and rotations (1 angle per pose in
+// 2D; 4 quaternion coefficients x, y, z, w per pose in 3D), contiguous.
+struct CeresPoseBlocks {
+  int dimension = 0;
+  std::vector<double> translations;
+  std::vector<double> rotations;
+
+  int num_poses() const {
+    return dimension > 0 ? static_cast<int>(translations.size()) / dimension
+                         : 0;
+  }
+  double* translation(int i) { return translations.data() + dimension * i; }
+  double* rotation(int i) {
+    return rotations.data() + (dimension == 2 ? 1 : 4) * i;
+  }
+
+  // Converts poses (rotations projected onto SO(d) through the angle /
+  // normalized quaternion) into blocks. Returns false if dimension is not 2
+  // or 3 or a pose has the wrong size or non-finite entries.
+  bool FromPoses(int dimension, const Poses& poses, std::string* error);
+  // Converts the blocks back into poses (quaternions normalized).
+  Poses ToPoses() const;
+};
+
+// Adds one residual block per measurement of `graph` over the parameter
+// blocks in `blocks` (which must outlive `problem` and have graph.num_poses
+// poses), sets the quaternion manifolds (3D) and holds the gauge pose
+// (graph.fixed_pose if >= 0, else pose 0) constant. `problem` should be empty
+// and use the default ownership options. Returns false (problem untouched)
+// if the graph fails ValidatePoseGraph or the sizes disagree.
+bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
+                       ceres::Problem* problem, std::string* error);
+
+// Minimizes eq. (12) with Ceres from `initial` (graph.num_poses poses). The
+// gauge pose (graph.fixed_pose if >= 0, else pose 0) stays at its initial
+// value. Linear solver: SPARSE_NORMAL_CHOLESKY with SuiteSparse. On success
+// fills `result` and `summary` (if not null) and returns true, also when
+// Ceres stopped at the iteration or time limit (see
+// summary->solver_summary.termination_type). Returns false with a message
+// for invalid input or if Ceres reports a failure.
+bool SolveWithCeres(const PoseGraph& graph, const Poses& initial,
+                    const CeresBaselineOptions& options, Poses* result,
+                    CeresBaselineSummary* summary, std::string* error);
+
+// Odometry initialization: places the root pose (graph.fixed_pose if >= 0,
+// else pose 0) at graph.initial_poses[root] when initial poses are present,
+// else at the identity, and composes the measurements along a breadth-first
+// spanning tree of the measurement graph (neighbours visited in measurement
+// order): x_j = x_i * x~_ij over an edge (i, j) traversed forward, x_i = x_j *
+// x~_ij^-1 backward. Poses unreachable from the root (and all poses if the
+// graph has an invalid dimension) are left at the identity.
+Poses OdometryInitialization(const PoseGraph& graph);
+
+}  // namespace ceres_sesync
+
+#endif  // CERES_SESYNC_CERES_BASELINE_H_

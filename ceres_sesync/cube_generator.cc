@@ -1,0 +1,158 @@
+#include "ceres_sesync/cube_generator.h"
+
+#include <array>
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "Eigen/Geometry"
+#include "ceres_sesync/langevin.h"
+
+namespace ceres_sesync {
+
+namespace {
+
+constexpr int64_t kMaxPoses = 10000000;
+
+using LatticePoint = std::array<int, 3>;
+
+// The boustrophedon path through the lattice (see cube_generator.h).
+std::vector<LatticePoint> RectilinearPath(int d, int s) {
+  std::vector<LatticePoint> layer;
+  layer.reserve(static_cast<size_t>(s) * s);
+  for (int y = 0; y < s; ++y) {
+    for (int k = 0; k < s; ++k) {
+      layer.push_back({y % 2 == 0 ? k : s - 1 - k, y, 0});
+    }
+  }
+  if (d == 2) return layer;
+  std::vector<LatticePoint> path;
+  path.reserve(layer.size() * s);
+  for (int z = 0; z < s; ++z) {
+    for (size_t k = 0; k < layer.size(); ++k) {
+      LatticePoint p = z % 2 == 0 ? layer[k] : layer[layer.size() - 1 - k];
+      p[2] = z;
+      path.push_back(p);
+    }
+  }
+  return path;
+}
+
+// A rotation whose first column (the body's forward axis) is `forward`, a
+// lattice axis direction.
+Eigen::MatrixXd HeadingRotation(int d, const Eigen::Vector3d& forward) {
+  if (d == 2) {
+    Eigen::MatrixXd R(2, 2);
+    R << forward.x(), -forward.y(), forward.y(), forward.x();
+    return R;
+  }
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d left = std::abs(forward.z()) > 0.5
+                                   ? Eigen::Vector3d::UnitY().eval()
+                                   : up.cross(forward).eval();
+  Eigen::MatrixXd R(3, 3);
+  R.col(0) = forward;
+  R.col(1) = left;
+  R.col(2) = forward.cross(left);
+  return R;
+}
+
+}  // namespace
+
+double ExpectedGroundTruthObjective(int dimension, int num_measurements,
+                                    double kappa) {
+  return num_measurements *
+         (4 * kappa * (1 - VonMisesMeanCosine(2 * kappa)) + dimension);
+}
+
+bool GenerateCube(const CubeOptions& options, PoseGraph* graph,
+                  Poses* ground_truth, std::string* error) {
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  const int d = options.dimension;
+  const int s = options.side;
+  if (d != 2 && d != 3) return fail("cube dimension must be 2 or 3");
+  if (s < 2) return fail("cube side must be at least 2");
+  int64_t n64 = 1;
+  for (int k = 0; k < d; ++k) {
+    n64 *= s;
+    if (n64 > kMaxPoses) {
+      std::ostringstream m;
+      m << "cube side " << s << " gives more than " << kMaxPoses << " poses";
+      return fail(m.str());
+    }
+  }
+  const double p_lc = options.loop_closure_probability;
+  if (!(p_lc >= 0 && p_lc <= 1)) {
+    return fail("loop closure probability must be in [0, 1]");
+  }
+  if (!(options.kappa > 0 && std::isfinite(options.kappa))) {
+    return fail("kappa must be finite and positive");
+  }
+  if (!(options.tau > 0 && std::isfinite(options.tau))) {
+    return fail("tau must be finite and positive");
+  }
+  if (!(options.spacing > 0 && std::isfinite(options.spacing))) {
+    return fail("spacing must be finite and positive");
+  }
+  const int n = static_cast<int>(n64);
+
+  // Ground truth along the path.
+  const std::vector<LatticePoint> path = RectilinearPath(d, s);
+  std::vector<int> index_of_point(static_cast<size_t>(n));
+  auto flat = [s](const LatticePoint& p) {
+    return static_cast<size_t>(p[0]) +
+           static_cast<size_t>(s) * (p[1] + static_cast<size_t>(s) * p[2]);
+  };
+  for (int i = 0; i < n; ++i) index_of_point[flat(path[i])] = i;
+  Poses truth(n);
+  for (int i = 0; i < n; ++i) {
+    const int a = i + 1 < n ? i : i - 1;  // heading from a to a + 1
+    Eigen::Vector3d forward;
+    for (int k = 0; k < 3; ++k) forward[k] = path[a + 1][k] - path[a][k];
+    truth[i].R = HeadingRotation(d, forward);
+    truth[i].t.resize(d);
+    for (int k = 0; k < d; ++k) truth[i].t[k] = options.spacing * path[i][k];
+  }
+
+  // Measurements.
+  PoseGraph g;
+  g.dimension = d;
+  for (int i = 0; i < n; ++i) g.AddVertex(i);
+  std::mt19937_64 rng(options.seed);
+  auto add_measurement = [&](int i, int j) {
+    RelativePoseMeasurement e;
+    e.i = i;
+    e.j = j;
+    e.kappa = options.kappa;
+    e.tau = options.tau;
+    e.R = truth[i].R.transpose() * truth[j].R *
+          SampleIsotropicLangevin(d, options.kappa, &rng);
+    e.t = truth[i].R.transpose() * (truth[j].t - truth[i].t);
+    const double sigma = 1 / std::sqrt(options.tau);
+    for (int k = 0; k < d; ++k) e.t[k] += sigma * SampleStandardNormal(&rng);
+    g.measurements.push_back(std::move(e));
+  };
+  for (int j = 1; j < n; ++j) {
+    add_measurement(j - 1, j);
+    for (int axis = 0; axis < d; ++axis) {
+      for (int step : {-1, 1}) {
+        LatticePoint q = path[j];
+        q[axis] += step;
+        if (q[axis] < 0 || q[axis] >= s) continue;
+        const int i = index_of_point[flat(q)];
+        if (i >= j - 1) continue;  // later, or the odometry predecessor
+        if (SampleUniform01(&rng) < p_lc) add_measurement(i, j);
+      }
+    }
+  }
+  if (graph) *graph = std::move(g);
+  if (ground_truth) *ground_truth = std::move(truth);
+  return true;
+}
+
+}  // namespace ceres_sesync

@@ -1,0 +1,290 @@
+// Tests of the synthetic cube generator: structure (lattice path, odometry,
+// loop closures), noise statistics against closed forms, determinism, and
+// option validation.
+
+#include "ceres_sesync/cube_generator.h"
+
+#include <cmath>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "Eigen/LU"
+#include "ceres_sesync/langevin.h"
+#include "gtest/gtest.h"
+
+namespace ceres_sesync {
+namespace {
+
+bool IsRotation(const Eigen::MatrixXd& R, int d) {
+  return R.rows() == d && R.cols() == d &&
+         (R.transpose() * R - Eigen::MatrixXd::Identity(d, d)).norm() < 1e-12 &&
+         std::abs(R.determinant() - 1) < 1e-12;
+}
+
+PoseGraph Generate(const CubeOptions& options, Poses* truth) {
+  PoseGraph graph;
+  std::string error;
+  EXPECT_TRUE(GenerateCube(options, &graph, truth, &error)) << error;
+  return graph;
+}
+
+// Unordered pairs {i, j}, |i - j| > 1, whose true positions are exactly one
+// lattice spacing apart: the loop-closure candidates, found by brute force.
+int CountCandidatePairs(const Poses& truth, double spacing) {
+  int count = 0;
+  const int n = static_cast<int>(truth.size());
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 2; j < n; ++j) {
+      if (std::abs((truth[i].t - truth[j].t).norm() - spacing) < 1e-9) ++count;
+    }
+  }
+  return count;
+}
+
+TEST(GenerateCube, StructureOfGraphAndGroundTruth) {
+  for (int d : {2, 3}) {
+    for (int s : {2, 3, 5}) {
+      SCOPED_TRACE(::testing::Message() << "d=" << d << " s=" << s);
+      CubeOptions options;
+      options.dimension = d;
+      options.side = s;
+      options.spacing = 1.5;
+      options.seed = 42;
+      Poses truth;
+      const PoseGraph graph = Generate(options, &truth);
+      const int n = static_cast<int>(std::pow(s, d) + 0.5);
+      ASSERT_EQ(graph.num_poses, n);
+      ASSERT_EQ(static_cast<int>(truth.size()), n);
+      EXPECT_EQ(graph.dimension, d);
+      EXPECT_TRUE(graph.initial_poses.empty());
+      EXPECT_EQ(graph.fixed_pose, -1);
+      std::string error;
+      EXPECT_TRUE(ValidatePoseGraph(graph, &error)) << error;  // connected
+      for (int i = 0; i < n; ++i) EXPECT_EQ(graph.vertex_ids[i], i);
+
+      // Ground truth: every lattice point visited once; unit steps along one
+      // axis; each pose faces its direction of travel.
+      std::set<std::vector<long>> visited;
+      for (int i = 0; i < n; ++i) {
+        ASSERT_TRUE(IsRotation(truth[i].R, d));
+        std::vector<long> cell(d);
+        for (int k = 0; k < d; ++k) {
+          const double c = truth[i].t[k] / options.spacing;
+          cell[k] = std::lround(c);
+          EXPECT_NEAR(c, cell[k], 1e-12);
+          EXPECT_GE(cell[k], 0);
+          EXPECT_LT(cell[k], s);
+        }
+        visited.insert(cell);
+        if (i + 1 < n) {
+          const Eigen::VectorXd step = truth[i + 1].t - truth[i].t;
+          EXPECT_NEAR(step.norm(), options.spacing, 1e-12);
+          EXPECT_NEAR(step.cwiseAbs().maxCoeff(), options.spacing, 1e-12);
+          EXPECT_LT((truth[i].R.col(0) - step / options.spacing).norm(), 1e-12)
+              << "pose " << i << " does not face its direction of travel";
+        }
+      }
+      EXPECT_EQ(static_cast<int>(visited.size()), n);
+
+      // Odometry: exactly one edge (j - 1, j) per j >= 1. Loop closures:
+      // lattice neighbours, non-sequential, each pair at most once.
+      std::vector<int> odometry(n, 0);
+      std::set<std::pair<int, int>> closures;
+      for (const RelativePoseMeasurement& e : graph.measurements) {
+        EXPECT_EQ(e.kappa, options.kappa);
+        EXPECT_EQ(e.tau, options.tau);
+        ASSERT_LT(e.i, e.j);
+        if (e.j == e.i + 1) {
+          ++odometry[e.j];
+        } else {
+          EXPECT_NEAR((truth[e.i].t - truth[e.j].t).norm(), options.spacing,
+                      1e-12);
+          EXPECT_TRUE(closures.insert({e.i, e.j}).second);
+        }
+      }
+      for (int j = 1; j < n; ++j) EXPECT_EQ(odometry[j], 1) << j;
+    }
+  }
+}
+
+TEST(GenerateCube, CandidateCountMatchesLatticeFormula) {
+  // All lattice-neighbour pairs, d s^(d-1) (s-1), minus the n-1 consecutive
+  // ones; pLC = 1 must take all of them and pLC = 0 none.
+  for (int d : {2, 3}) {
+    const int s = 4;
+    CubeOptions options;
+    options.dimension = d;
+    options.side = s;
+    Poses truth;
+    options.loop_closure_probability = 1;
+    const PoseGraph all = Generate(options, &truth);
+    const int n = all.num_poses;
+    const int candidates =
+        d * static_cast<int>(std::pow(s, d - 1) + 0.5) * (s - 1) - (n - 1);
+    EXPECT_EQ(CountCandidatePairs(truth, options.spacing), candidates);
+    EXPECT_EQ(static_cast<int>(all.measurements.size()) - (n - 1), candidates);
+    options.loop_closure_probability = 0;
+    const PoseGraph none = Generate(options, nullptr);
+    EXPECT_EQ(static_cast<int>(none.measurements.size()), n - 1);
+  }
+}
+
+TEST(GenerateCube, LoopClosureCountIsBinomial) {
+  // The number of loop closures is Binomial(N, pLC) with N the candidate
+  // count; accept within 5 standard deviations (per seed and in total).
+  for (int d : {2, 3}) {
+    for (double p : {0.1, 0.5}) {
+      long total = 0, total_candidates = 0;
+      for (uint64_t seed = 0; seed < 5; ++seed) {
+        CubeOptions options;
+        options.dimension = d;
+        options.side = d == 3 ? 8 : 20;
+        options.loop_closure_probability = p;
+        options.seed = seed;
+        Poses truth;
+        const PoseGraph graph = Generate(options, &truth);
+        const int candidates = CountCandidatePairs(truth, options.spacing);
+        const int closures =
+            static_cast<int>(graph.measurements.size()) - (graph.num_poses - 1);
+        const double sd = std::sqrt(candidates * p * (1 - p));
+        EXPECT_LE(std::abs(closures - candidates * p), 5 * sd)
+            << "d=" << d << " p=" << p << " seed=" << seed;
+        total += closures;
+        total_candidates += candidates;
+      }
+      EXPECT_LE(std::abs(total - total_candidates * p),
+                5 * std::sqrt(total_candidates * p * (1 - p)));
+    }
+  }
+}
+
+TEST(GenerateCube, NoiselessLimitReproducesGroundTruth) {
+  // kappa = tau = 1e12: rotation noise ~ 1/sqrt(2e12) ~ 7e-7 rad, translation
+  // noise ~ 1e-6 m. Measurements must match the true relative poses to that
+  // level, and F(truth) must be O(m) (each edge contributes E = 1 + d) while
+  // F of the same weights at a 1e-3 perturbation is ~1e6 times larger.
+  for (int d : {2, 3}) {
+    CubeOptions options;
+    options.dimension = d;
+    options.side = 4;
+    options.kappa = 1e12;
+    options.tau = 1e12;
+    Poses truth;
+    const PoseGraph graph = Generate(options, &truth);
+    const int m = static_cast<int>(graph.measurements.size());
+    for (const RelativePoseMeasurement& e : graph.measurements) {
+      const Eigen::MatrixXd R = truth[e.i].R.transpose() * truth[e.j].R;
+      const Eigen::VectorXd t =
+          truth[e.i].R.transpose() * (truth[e.j].t - truth[e.i].t);
+      EXPECT_LT((e.R - R).norm(), 1e-5);
+      EXPECT_LT((e.t - t).norm(), 1e-5);
+    }
+    const double f = EvaluateObjective(graph, truth);
+    EXPECT_LT(f / (options.kappa * m), 1e-10);
+    EXPECT_LT(f, 10.0 * (1 + d) * m);
+  }
+}
+
+TEST(GenerateCube, DeterministicForASeed) {
+  CubeOptions options;
+  options.side = 4;
+  options.loop_closure_probability = 0.3;
+  options.seed = 123;
+  const PoseGraph a = Generate(options, nullptr);
+  const PoseGraph b = Generate(options, nullptr);
+  ASSERT_EQ(a.measurements.size(), b.measurements.size());
+  for (size_t k = 0; k < a.measurements.size(); ++k) {
+    EXPECT_EQ(a.measurements[k].i, b.measurements[k].i);
+    EXPECT_EQ(a.measurements[k].j, b.measurements[k].j);
+    EXPECT_EQ(a.measurements[k].R, b.measurements[k].R);  // bitwise
+    EXPECT_EQ(a.measurements[k].t, b.measurements[k].t);
+  }
+  options.seed = 124;
+  const PoseGraph c = Generate(options, nullptr);
+  // Another seed: different noise on the first odometry edge (a collision
+  // has probability 0) and, almost surely, different measurements overall.
+  EXPECT_NE(a.measurements[0].t, c.measurements[0].t);
+  EXPECT_NE(a.measurements[0].R, c.measurements[0].R);
+}
+
+TEST(GenerateCube, GroundTruthObjectiveMatchesExpectation) {
+  // Per edge, F_e(x_true) = kappa ||P - I||^2 + tau ||eps||^2 with P ~
+  // Langevin(I, kappa) and eps ~ N(0, tau^-1 I_d), so E[F_e] = 4 kappa (1 -
+  // I1(2 kappa) / I0(2 kappa)) + d. The per-edge contributions are i.i.d.;
+  // their mean must be within 5 standard errors of E[F_e].
+  struct Case {
+    int d, side;
+    double kappa, tau;
+  };
+  for (const Case& c : {Case{3, 10, 16.67, 75}, Case{3, 8, 1.0, 5},
+                        Case{2, 40, 16.67, 75}, Case{2, 40, 300, 0.5}}) {
+    CubeOptions options;
+    options.dimension = c.d;
+    options.side = c.side;
+    options.kappa = c.kappa;
+    options.tau = c.tau;
+    options.seed = 99;
+    Poses truth;
+    const PoseGraph graph = Generate(options, &truth);
+    const int m = static_cast<int>(graph.measurements.size());
+    double sum = 0, sum2 = 0, total = 0;
+    for (const RelativePoseMeasurement& e : graph.measurements) {
+      const Pose& a = truth[e.i];
+      const Pose& b = truth[e.j];
+      const double f = e.kappa * (b.R - a.R * e.R).squaredNorm() +
+                       e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
+      sum += f;
+      sum2 += f * f;
+    }
+    total = EvaluateObjective(graph, truth);
+    const double mean = sum / m;
+    const double standard_error = std::sqrt((sum2 / m - mean * mean) / (m - 1));
+    const double expected = ExpectedGroundTruthObjective(c.d, m, c.kappa) / m;
+    EXPECT_NEAR(total, sum, 1e-9 * sum);
+    EXPECT_LE(std::abs(mean - expected), 5 * standard_error)
+        << "d=" << c.d << " kappa=" << c.kappa << ": mean " << mean
+        << " expected " << expected << " se " << standard_error;
+  }
+  // Closed form at the paper's default: 4 * 16.67 * (1 - A(33.34)) ~ 1.0,
+  // plus d: about 4 per edge in 3D.
+  EXPECT_NEAR(ExpectedGroundTruthObjective(3, 1, 16.67), 4.0, 0.05);
+}
+
+TEST(GenerateCube, RejectsInvalidOptions) {
+  auto expect_error = [](const CubeOptions& options) {
+    PoseGraph graph;
+    Poses truth;
+    std::string error;
+    EXPECT_FALSE(GenerateCube(options, &graph, &truth, &error));
+    EXPECT_FALSE(error.empty());
+  };
+  CubeOptions o;
+  o.dimension = 4;
+  expect_error(o);
+  o = CubeOptions();
+  o.side = 1;
+  expect_error(o);
+  o = CubeOptions();
+  o.side = 100000;  // 1e15 poses
+  expect_error(o);
+  o = CubeOptions();
+  o.loop_closure_probability = 1.5;
+  expect_error(o);
+  o = CubeOptions();
+  o.loop_closure_probability = NAN;
+  expect_error(o);
+  o = CubeOptions();
+  o.kappa = 0;
+  expect_error(o);
+  o = CubeOptions();
+  o.tau = INFINITY;
+  expect_error(o);
+  o = CubeOptions();
+  o.spacing = -1;
+  expect_error(o);
+}
+
+}  // namespace
+}  // namespace ceres_sesync
