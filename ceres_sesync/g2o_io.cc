@@ -184,18 +184,16 @@ bool CheckFieldCount(const Location& at,
                      const std::vector<std::string_view>& tokens,
                      int expected) {
   const int found = static_cast<int>(tokens.size()) - 1;
-  if (found < expected) {
-    return at.Fail(std::string(tokens[0]) + " needs " +
-                   std::to_string(expected) + " fields, found " +
-                   std::to_string(found));
-  }
+  if (found == expected) return true;
+  std::string message = std::string(tokens[0]) + " needs " +
+                        std::to_string(expected) +
+                        (expected == 1 ? " field" : " fields") + ", found " +
+                        std::to_string(found);
   if (found > expected) {
-    return at.Fail(std::string(tokens[0]) + " needs " +
-                   std::to_string(expected) + " fields, found " +
-                   std::to_string(found) + " (unexpected trailing '" +
-                   std::string(tokens[expected + 1]) + "')");
+    message +=
+        " (unexpected trailing '" + std::string(tokens[expected + 1]) + "')";
   }
-  return true;
+  return at.Fail(message);
 }
 
 Eigen::MatrixXd RotationFromAngle(double theta) {

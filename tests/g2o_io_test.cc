@@ -283,7 +283,7 @@ TEST(G2oReadTest, VertexLinesDefineThePoseOrderAndFixIsHonoured) {
       "EDGE_SE2 30 20 1 0 0 1 0 0 1 0 1\n"
       "VERTEX_SE2 20 1 2 0.5\n"
       "VERTEX_SE2 30 0 0 0\n"
-      "VERTEX_SE2 10 0 0 0\n"
+      "VERTEX2 10 0 0 0\n"  // Legacy TORO tag, same layout.
       "FIX 30\n";
   G2oReadSummary summary;
   const PoseGraph graph = ReadText(text, &summary);
