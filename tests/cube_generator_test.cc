@@ -4,13 +4,18 @@
 
 #include "ceres_sesync/cube_generator.h"
 
+#include <sys/wait.h>
+
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "Eigen/LU"
+#include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/langevin.h"
 #include "gtest/gtest.h"
 
@@ -284,6 +289,85 @@ TEST(GenerateCube, RejectsInvalidOptions) {
   o = CubeOptions();
   o.spacing = -1;
   expect_error(o);
+}
+
+// Runs the tool with `arguments`; returns its exit code.
+int RunTool(const std::string& arguments) {
+  const std::string command =
+      std::string(CERES_SESYNC_TOOL) + " " + arguments + " >/dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(GenerateCommand, WritesTheGeneratedGraph) {
+  if (std::string(CERES_SESYNC_TOOL).empty()) {
+    GTEST_SKIP() << "the ceres_sesync tool is not built";
+  }
+  const std::string dir = std::string(CERES_SESYNC_BINARY_DIR);
+  const std::string output = dir + "/cube_generator_test_graph.g2o";
+  const std::string truth_path = dir + "/cube_generator_test_truth.g2o";
+  for (int d : {2, 3}) {
+    SCOPED_TRACE(d);
+    std::remove(output.c_str());
+    std::remove(truth_path.c_str());
+    ASSERT_EQ(
+        RunTool("generate cube --side 3 --dimension " + std::to_string(d) +
+                " --loop_closure_probability 0.5 --kappa 20 --tau 50 "
+                "--seed 17 --output " +
+                output + " --ground_truth " + truth_path),
+        0);
+    CubeOptions options;
+    options.dimension = d;
+    options.side = 3;
+    options.loop_closure_probability = 0.5;
+    options.kappa = 20;
+    options.tau = 50;
+    options.seed = 17;
+    Poses truth;
+    const PoseGraph expected = Generate(options, &truth);
+
+    PoseGraph graph;
+    std::string error;
+    ASSERT_TRUE(ReadG2oFile(output, G2oReadOptions(), &graph, &error)) << error;
+    ASSERT_EQ(graph.dimension, d);
+    ASSERT_EQ(graph.num_poses, expected.num_poses);
+    ASSERT_EQ(graph.measurements.size(), expected.measurements.size());
+    for (size_t k = 0; k < graph.measurements.size(); ++k) {
+      const RelativePoseMeasurement& a = graph.measurements[k];
+      const RelativePoseMeasurement& b = expected.measurements[k];
+      EXPECT_EQ(graph.vertex_ids[a.i], b.i);
+      EXPECT_EQ(graph.vertex_ids[a.j], b.j);
+      // The file stores rotations as angles / quaternions: ~1e-15 apart.
+      EXPECT_LT((a.R - b.R).norm(), 1e-12);
+      EXPECT_LT((a.t - b.t).norm(), 1e-12);
+      EXPECT_NEAR(a.kappa, b.kappa, 1e-12 * b.kappa);
+      EXPECT_NEAR(a.tau, b.tau, 1e-12 * b.tau);
+    }
+    // Default VERTEX lines: dead reckoning along the odometry from identity.
+    ASSERT_EQ(static_cast<int>(graph.initial_poses.size()), graph.num_poses);
+    EXPECT_LT(graph.initial_poses[0].t.norm(), 1e-15);
+    Poses file_truth;
+    ASSERT_TRUE(ReadG2oPoses(truth_path, graph, &file_truth, &error)) << error;
+    for (int i = 0; i < graph.num_poses; ++i) {
+      const int v = static_cast<int>(graph.vertex_ids[i]);
+      EXPECT_LT((file_truth[i].R - truth[v].R).norm(), 1e-12);
+      EXPECT_LT((file_truth[i].t - truth[v].t).norm(), 1e-12);
+    }
+  }
+  // Usage errors exit with 2 and write nothing.
+  std::remove(output.c_str());
+  EXPECT_EQ(RunTool("generate"), 2);
+  EXPECT_EQ(RunTool("generate sphere --output " + output), 2);
+  EXPECT_EQ(RunTool("generate cube"), 2);
+  EXPECT_EQ(RunTool("generate cube extra --output " + output), 2);
+  EXPECT_EQ(RunTool("generate cube --side 1 --output " + output), 2);
+  EXPECT_EQ(RunTool("generate cube --dimension 4 --output " + output), 2);
+  EXPECT_EQ(RunTool("generate cube --kappa -1 --output " + output), 2);
+  EXPECT_EQ(RunTool("generate cube --vertices bogus --output " + output), 2);
+  FILE* f = std::fopen(output.c_str(), "r");
+  EXPECT_EQ(f, nullptr) << "a failed run left " << output;
+  if (f) std::fclose(f);
+  std::remove(truth_path.c_str());
 }
 
 }  // namespace
