@@ -20,9 +20,11 @@ struct TcgResult {
 
 // Preconditioned Steihaug-Toint truncated CG for min <g, eta> + 1/2 <H eta,
 // eta> subject to <eta, P^{-1} eta> <= radius^2.
+// The superlinear stopping term is made scale-free by measuring ||r0|| against
+// reference_norm (the gradient norm at the start of the solve).
 TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
                       RiemannianCostFunction* cost, const Eigen::MatrixXd& g,
-                      double radius) {
+                      double radius, double reference_norm) {
   TcgResult out;
   out.eta.setZero(g.rows(), g.cols());
   out.h_eta.setZero(g.rows(), g.cols());
@@ -33,7 +35,8 @@ TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
   double e_pe = 0, e_pd = 0, d_pd = z_r;
   const double r0 = std::sqrt(Inner(r, r));
   const double target =
-      r0 * std::min(std::pow(r0, options.tcg_theta), options.tcg_kappa);
+      r0 * std::min(std::pow(r0 / reference_norm, options.tcg_theta),
+                    options.tcg_kappa);
   const double radius2 = radius * radius;
   for (int j = 0; j < options.max_inner_iterations; ++j) {
     cost->HessianVector(delta, &h_delta);
@@ -108,6 +111,7 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
   summary->initial_cost = f;
   Eigen::MatrixXd g, pg, x_new;
   double radius = options.initial_trust_radius;
+  double reference_norm = 1;
   auto finish = [&](Termination t) {
     summary->termination = t;
     summary->final_cost = f;
@@ -133,6 +137,7 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
     if (options.max_time_s > 0 && elapsed() >= options.max_time_s) {
       return finish(Termination::kMaxTime);
     }
+    if (k == 0) reference_norm = g_norm;
     if (radius <= 0) {
       // Initial radius: the length (in the P^{-1} norm) of the preconditioned
       // steepest-descent step -P g, a scale-free choice.
@@ -140,7 +145,8 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
     }
     // Inner solve, then shrink the radius until a step is accepted.
     for (;;) {
-      const TcgResult step = TruncatedCg(options, cost, g, radius);
+      const TcgResult step =
+          TruncatedCg(options, cost, g, radius, reference_norm);
       summary->hessian_vector_products += step.iterations;
       const double model_decrease =
           -(Inner(g, step.eta) + 0.5 * Inner(step.eta, step.h_eta));

@@ -59,7 +59,8 @@ struct RiemannianTrustRegionOptions {
   // Initial trust radius (in the preconditioner's norm); <= 0 means "from the
   // first Cauchy step".
   double initial_trust_radius = -1;
-  // Truncated-CG stopping: ||r|| <= ||r0|| min(||r0||^theta, kappa).
+  // Truncated-CG stopping: ||r|| <= ||r0|| min((||r0|| / ||g_0||)^theta,
+  // kappa), with g_0 the gradient at the start (scale-free).
   double tcg_kappa = 0.1;
   double tcg_theta = 1.0;
   // Wall-clock limit in seconds (<= 0: none).

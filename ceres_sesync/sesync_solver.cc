@@ -31,8 +31,10 @@ internal::PreconditionerType ToInternal(SolverOptions::Preconditioner p) {
       return internal::PreconditionerType::kNone;
     case SolverOptions::Preconditioner::kBlockJacobi:
       return internal::PreconditionerType::kBlockJacobi;
-    case SolverOptions::Preconditioner::kRegularizedCholesky:
-      return internal::PreconditionerType::kRegularizedCholesky;
+    case SolverOptions::Preconditioner::kSparseCholesky:
+      return internal::PreconditionerType::kSparseCholesky;
+    case SolverOptions::Preconditioner::kRegularizedQ:
+      return internal::PreconditionerType::kRegularizedQ;
   }
   return internal::PreconditionerType::kNone;
 }

@@ -33,7 +33,18 @@ struct SolverOptions {
     kRandom,    // A uniformly random point of St(d, r0)^n.
     kVertices,  // The graph's own initial_poses (from VERTEX lines).
   };
-  enum class Preconditioner { kNone, kBlockJacobi, kRegularizedCholesky };
+  enum class Preconditioner {
+    kNone,
+    // Inverse d x d diagonal blocks of D = L(G^rho) + Sigma~ (Q's sparse
+    // part), regularized.
+    kBlockJacobi,
+    // Sparse Cholesky of D + eps I.
+    kSparseCholesky,
+    // (Q + eps I)^{-1} applied exactly through a sparse Cholesky factor of the
+    // translation-augmented matrix [Lbar -Vbar; -Vbar^T D + eps I] (its Schur
+    // complement is Q + eps I). Best on strongly translation-coupled graphs.
+    kRegularizedQ,
+  };
 
   // How the staircase is started. Solve(graph, initial, ...) overrides this.
   Initialization initialization = Initialization::kChordal;
@@ -45,8 +56,8 @@ struct SolverOptions {
   int max_rank = 10;
 
   // Preconditioner of the truncated CG inner solver, and the condition number
-  // cap of the regularized Cholesky one (D + (lambda_max(D)/cap) I).
-  Preconditioner preconditioner = Preconditioner::kRegularizedCholesky;
+  // cap of the regularized ones: eps = lambda_max(D) / cap.
+  Preconditioner preconditioner = Preconditioner::kRegularizedQ;
   double regularized_cholesky_max_condition = 1e6;
 
   // Local optimization at each rank (Riemannian trust region): the paper's

@@ -87,68 +87,245 @@ class SvdPolar {
   Eigen::JacobiSVD<Tall<D>> svd_;
 };
 
-// out_i = polar factor of (Y_i + V_i) (V may be null, meaning zero). Both y
-// and v may alias out: each block is first copied into a workspace.
+// Inverse square root M ~ G^(-1/2) of a symmetric positive-definite d x d
+// matrix G, as a polynomial in G (so M commutes with G exactly, up to
+// rounding). Returns false unless G is comfortably well conditioned
+// (lambda_min > kMinEigenvalueRatio * lambda_max), in which case the caller
+// falls back to an SVD.
+//
+// Why a polynomial in G suffices: for x with x^T x = G and any symmetric
+// positive-definite M commuting with G, polar(x M) = polar(x). So small
+// errors in M only make x M slightly non-orthonormal, and the Newton-Schulz
+// polishing in PolarKernel (which converges to polar(x M)) removes
+// them without changing the retraction.
+constexpr double kMinEigenvalueRatio = 1e-4;  // cond(x) < 100.
+
+// Newton-Schulz polishing stops once max |Q^T Q - I| is below this: a few
+// ulps, the rounding floor of evaluating Q^T Q itself (and 20x below the
+// 1e-14 orthonormality the solver relies on).
+constexpr double kPolishThreshold = 1e-15;
+
 template <int D>
-void PolarRetractionKernel(const double* y, const double* v, int r, int d,
-                           int n, double* out) {
-  Tall<D> x(r, d);
-  Small<D> gram(d, d);
-  Small<D> inv_sqrt(d, d);
-  SmallVector<D> scale(d);
-  Eigen::SelfAdjointEigenSolver<Small<D>> eig(d);
-  std::unique_ptr<SvdPolar<D>> svd;  // Only for rank-deficient blocks.
-  const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(r) * d;
-  for (int i = 0; i < n; ++i) {
-    ConstBlock<D> y_i(y + i * stride, r, d);
-    if (v != nullptr) {
-      x = y_i + ConstBlock<D>(v + i * stride, r, d);
-    } else {
-      x = y_i;
+class InverseSqrt {
+ public:
+  explicit InverseSqrt(int d) : eig_(d), scale_(d) {}
+  // Dynamic fallback: symmetric eigendecomposition.
+  bool Compute(const Small<D>& g, Small<D>* m) {
+    eig_.compute(g);
+    if (eig_.info() != Eigen::Success) return false;
+    const auto& lambda = eig_.eigenvalues();  // Ascending.
+    const int d = static_cast<int>(g.rows());
+    if (!std::isfinite(lambda(d - 1)) ||
+        !(lambda(0) > kMinEigenvalueRatio * lambda(d - 1))) {
+      return false;
     }
-    MutableBlock<D> out_i(out + i * stride, r, d);
-    gram.noalias() = x.transpose().lazyProduct(x);
-    eig.compute(gram);
-    const SmallVector<D>& lambda = eig.eigenvalues();  // Ascending.
-    // The eigenvalue route loses accuracy like eps * cond(x)^2; use it only
-    // when cond(x) < 100 (always true for a tangent V with ||V||_2 < 99,
-    // since then gram = I + V^T V). Otherwise fall back to an SVD.
-    const bool well_conditioned =
-        eig.info() == Eigen::Success && std::isfinite(lambda(d - 1)) &&
-        lambda(0) > 1e-4 * lambda(d - 1) && lambda(0) > 0.0;
-    if (!well_conditioned) {
-      if (!svd) svd = std::make_unique<SvdPolar<D>>(r, d);
-      svd->Compute(x, &out_i);
+    scale_ = lambda.cwiseSqrt().cwiseInverse();
+    m->noalias() = eig_.eigenvectors() * scale_.asDiagonal() *
+                   eig_.eigenvectors().transpose();
+    return true;
+  }
+
+ private:
+  Eigen::SelfAdjointEigenSolver<Small<D>> eig_;
+  SmallVector<D> scale_;
+};
+
+// d = 2: sqrt(G) = (G + s I) / t with s = sqrt(det G), t = sqrt(tr G + 2 s),
+// hence G^(-1/2) = t (G + s I)^(-1) = ((tr G + s) I - G) / (s t).
+template <>
+class InverseSqrt<2> {
+ public:
+  explicit InverseSqrt(int /*d*/) {}
+  bool Compute(const Eigen::Matrix2d& g, Eigen::Matrix2d* m) {
+    const double a = g(0, 0), b = g(0, 1), c = g(1, 1);
+    const double trace = a + c;
+    const double half_gap = std::hypot(0.5 * (a - c), b);
+    const double lambda_max = 0.5 * trace + half_gap;
+    const double det = a * c - b * b;
+    if (!std::isfinite(lambda_max) ||
+        !(det > kMinEigenvalueRatio * lambda_max * lambda_max)) {
+      return false;
+    }
+    const double s = std::sqrt(det);
+    const double st = s * std::sqrt(trace + 2.0 * s);
+    (*m)(0, 0) = (trace + s - a) / st;
+    (*m)(1, 1) = (trace + s - c) / st;
+    (*m)(0, 1) = (*m)(1, 0) = -b / st;
+    return true;
+  }
+};
+
+// d = 3: eigenvalues in closed form (trigonometric solution of the shifted,
+// scaled characteristic polynomial), then the square root U = sqrt(G) from the
+// invariants of its eigenvalues mu_i = sqrt(lambda_i) (Cayley-Hamilton; e.g.
+// Franca, Comput. Math. Appl. 1989):
+//   U = (-G^2 + (I1^2 - I2) G + I1 I3 Id) / (I1 I2 - I3),
+//   U^(-1) = (G - I1 U + I2 Id) / I3,
+// with I1 = sum mu_i, I2 = sum_{i<j} mu_i mu_j, I3 = prod mu_i.
+template <>
+class InverseSqrt<3> {
+ public:
+  explicit InverseSqrt(int /*d*/) {}
+  bool Compute(const Eigen::Matrix3d& g, Eigen::Matrix3d* m) {
+    const double q = g.trace() / 3.0;
+    const double b00 = g(0, 0) - q, b11 = g(1, 1) - q, b22 = g(2, 2) - q;
+    const double b01 = g(0, 1), b02 = g(0, 2), b12 = g(1, 2);
+    const double p2 = (b00 * b00 + b11 * b11 + b22 * b22 +
+                       2.0 * (b01 * b01 + b02 * b02 + b12 * b12)) /
+                      6.0;
+    double lambda1 = q, lambda2 = q, lambda3 = q;  // Descending.
+    if (p2 > 0.0) {
+      const double p = std::sqrt(p2);
+      const double inv_p = 1.0 / p;
+      const double c00 = b00 * inv_p, c11 = b11 * inv_p, c22 = b22 * inv_p;
+      const double c01 = b01 * inv_p, c02 = b02 * inv_p, c12 = b12 * inv_p;
+      const double det_c = c00 * (c11 * c22 - c12 * c12) -
+                           c01 * (c01 * c22 - c12 * c02) +
+                           c02 * (c01 * c12 - c11 * c02);
+      const double half_det = std::clamp(0.5 * det_c, -1.0, 1.0);
+      const double phi = std::acos(half_det) / 3.0;
+      constexpr double kTwoPiOverThree = 2.0943951023931954923;
+      lambda1 = q + 2.0 * p * std::cos(phi);
+      lambda3 = q + 2.0 * p * std::cos(phi + kTwoPiOverThree);
+      lambda2 = 3.0 * q - lambda1 - lambda3;
+    }
+    if (!std::isfinite(lambda1) || !(lambda3 > kMinEigenvalueRatio * lambda1) ||
+        !(lambda2 > 0.0)) {
+      return false;
+    }
+    const double mu1 = std::sqrt(lambda1), mu2 = std::sqrt(lambda2),
+                 mu3 = std::sqrt(lambda3);
+    const double i1 = mu1 + mu2 + mu3;
+    const double i2 = mu1 * mu2 + mu2 * mu3 + mu3 * mu1;
+    const double i3 = mu1 * mu2 * mu3;
+    const Eigen::Matrix3d g2 = g * g;
+    Eigen::Matrix3d u = (i1 * i1 - i2) * g - g2;
+    u.diagonal().array() += i1 * i3;
+    u /= (i1 * i2 - i3);
+    *m = g - i1 * u;
+    m->diagonal().array() += i2;
+    *m /= i3;
+    return true;
+  }
+};
+
+// out_i = polar factor of (Y_i + V_i) (v may be null, meaning zero): the
+// polar retraction, or (with v null) the projection onto St(d, r)^n. Both y
+// and v may alias out.
+//
+// Fixed d (2, 3): hand-written row loops (each output row depends only on the
+// same row of the input, which is what makes aliasing safe), then Newton-
+// Schulz polishing Q <- Q (3 I - Q^T Q) / 2, which converges quadratically to
+// polar(Q) = polar(x) and leaves Q orthonormal to rounding level (typically
+// one step). For a tangent V, x^T x = I + V^T V, so the fast path is taken
+// whenever ||V||_2 < 99; an SVD handles everything else (ill conditioning,
+// rank deficiency, non-finite input).
+template <int D>
+void PolarKernel(const double* y, const double* v, int r, int d, int n,
+                 double* out) {
+  static_assert(D != Eigen::Dynamic, "see the specialization below");
+  (void)d;
+  InverseSqrt<D> inverse_sqrt(D);
+  Small<D> gram;
+  Small<D> m;
+  std::unique_ptr<SvdPolar<D>> svd;  // Only for ill-conditioned blocks.
+  std::unique_ptr<Tall<D>> copy;
+  const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(r) * D;
+  // Gram matrix of the r x D column-major block a (+ b if not null).
+  auto gram_of = [r](const double* a, const double* b, Small<D>* g) {
+    double acc[D][D] = {};
+    for (int j = 0; j < r; ++j) {
+      double row[D];
+      for (int k = 0; k < D; ++k) {
+        row[k] = a[j + k * r] + (b != nullptr ? b[j + k * r] : 0.0);
+      }
+      for (int k = 0; k < D; ++k) {
+        for (int l = k; l < D; ++l) acc[k][l] += row[k] * row[l];
+      }
+    }
+    for (int k = 0; k < D; ++k) {
+      for (int l = k; l < D; ++l) (*g)(k, l) = (*g)(l, k) = acc[k][l];
+    }
+  };
+  // o = (a + b) * c, row by row (o may alias a or b).
+  auto multiply = [r](const double* a, const double* b, const Small<D>& c,
+                      double* o) {
+    for (int j = 0; j < r; ++j) {
+      double row[D];
+      for (int k = 0; k < D; ++k) {
+        row[k] = a[j + k * r] + (b != nullptr ? b[j + k * r] : 0.0);
+      }
+      for (int k = 0; k < D; ++k) {
+        double sum = 0.0;
+        for (int l = 0; l < D; ++l) sum += row[l] * c(l, k);
+        o[j + k * r] = sum;
+      }
+    }
+  };
+  for (int i = 0; i < n; ++i) {
+    const double* y_i = y + i * stride;
+    const double* v_i = v != nullptr ? v + i * stride : nullptr;
+    double* out_i = out + i * stride;
+    gram_of(y_i, v_i, &gram);
+    if (!inverse_sqrt.Compute(gram, &m)) {
+      if (!svd) {
+        svd = std::make_unique<SvdPolar<D>>(r, D);
+        copy = std::make_unique<Tall<D>>(r, D);
+      }
+      *copy = ConstBlock<D>(y_i, r, D);
+      if (v_i != nullptr) *copy += ConstBlock<D>(v_i, r, D);
+      MutableBlock<D> out_map(out_i, r, D);
+      svd->Compute(*copy, &out_map);
       continue;
     }
-    scale = lambda.cwiseSqrt().cwiseInverse();
-    const Small<D>& u = eig.eigenvectors();
-    inv_sqrt.noalias() = u * scale.asDiagonal() * u.transpose();
-    out_i.noalias() = x.lazyProduct(inv_sqrt);
-    // One Newton-Schulz step Q <- Q (3 I - Q^T Q) / 2 polishes the
-    // orthonormality to rounding level; it converges to the same polar
-    // factor, so it does not change the retraction.
-    gram.noalias() = out_i.transpose().lazyProduct(out_i);
-    gram.diagonal().array() -= 1.0;
-    if (gram.cwiseAbs().maxCoeff() >
-        2.0 * std::numeric_limits<double>::epsilon()) {
-      inv_sqrt = -0.5 * gram;
-      inv_sqrt.diagonal().array() += 1.0;
-      x = out_i;
-      out_i.noalias() = x.lazyProduct(inv_sqrt);
+    multiply(y_i, v_i, m, out_i);
+    for (int step = 0; step < 3; ++step) {
+      gram_of(out_i, nullptr, &gram);
+      gram.diagonal().array() -= 1.0;
+      if (!(gram.cwiseAbs().maxCoeff() > kPolishThreshold)) break;
+      m = -0.5 * gram;
+      m.diagonal().array() += 1.0;
+      multiply(out_i, nullptr, m, out_i);
     }
   }
 }
 
-template <int D>
-void SvdProjectionKernel(const double* x, int r, int d, int n, double* out) {
-  SvdPolar<D> svd(r, d);
-  Tall<D> copy(r, d);
+// Dynamic d: the same algorithm with Eigen expressions and a symmetric
+// eigendecomposition for the inverse square root.
+template <>
+void PolarKernel<Eigen::Dynamic>(const double* y, const double* v, int r, int d,
+                                 int n, double* out) {
+  using MatrixX = Eigen::MatrixXd;
+  MatrixX x(r, d);
+  MatrixX gram(d, d);
+  MatrixX m(d, d);
+  InverseSqrt<Eigen::Dynamic> inverse_sqrt(d);
+  std::unique_ptr<SvdPolar<Eigen::Dynamic>> svd;
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(r) * d;
   for (int i = 0; i < n; ++i) {
-    copy = ConstBlock<D>(x + i * stride, r, d);
-    MutableBlock<D> out_i(out + i * stride, r, d);
-    svd.Compute(copy, &out_i);
+    ConstBlock<Eigen::Dynamic> y_i(y + i * stride, r, d);
+    if (v != nullptr) {
+      x = y_i + ConstBlock<Eigen::Dynamic>(v + i * stride, r, d);
+    } else {
+      x = y_i;
+    }
+    MutableBlock<Eigen::Dynamic> out_i(out + i * stride, r, d);
+    gram.noalias() = x.transpose() * x;
+    if (!inverse_sqrt.Compute(gram, &m)) {
+      if (!svd) svd = std::make_unique<SvdPolar<Eigen::Dynamic>>(r, d);
+      svd->Compute(x, &out_i);
+      continue;
+    }
+    out_i.noalias() = x * m;
+    for (int step = 0; step < 3; ++step) {
+      gram.noalias() = out_i.transpose() * out_i;
+      gram.diagonal().array() -= 1.0;
+      if (!(gram.cwiseAbs().maxCoeff() > kPolishThreshold)) break;
+      m = -0.5 * gram;
+      m.diagonal().array() += 1.0;
+      x = out_i;
+      out_i.noalias() = x * m;
+    }
   }
 }
 
@@ -429,7 +606,7 @@ void RetractStiefelProduct(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,
   }
   const int n = static_cast<int>(Y.cols() / d);
   out->resize(Y.rows(), Y.cols());  // No-op when out aliases Y or V.
-  CERES_SESYNC_DISPATCH_ON_D(d, PolarRetractionKernel, Y.data(), V.data(),
+  CERES_SESYNC_DISPATCH_ON_D(d, PolarKernel, Y.data(), V.data(),
                              static_cast<int>(Y.rows()), d, n, out->data());
 }
 
@@ -442,7 +619,7 @@ void ProjectToStiefelProduct(const Eigen::MatrixXd& X, int d,
   }
   const int n = static_cast<int>(X.cols() / d);
   out->resize(X.rows(), X.cols());
-  CERES_SESYNC_DISPATCH_ON_D(d, SvdProjectionKernel, X.data(),
+  CERES_SESYNC_DISPATCH_ON_D(d, PolarKernel, X.data(), nullptr,
                              static_cast<int>(X.rows()), d, n, out->data());
 }
 
@@ -514,7 +691,7 @@ bool StiefelManifold::Plus(const double* x, const double* delta,
   if (!ops.SetPoint(x) || !AllFinite(delta, TangentSize())) return false;
   std::vector<double> v(static_cast<size_t>(AmbientSize()));
   ops.CoordinatesToTangent(delta, v.data());
-  CERES_SESYNC_DISPATCH_ON_D(d_, PolarRetractionKernel, x, v.data(), r_, d_, 1,
+  CERES_SESYNC_DISPATCH_ON_D(d_, PolarKernel, x, v.data(), r_, d_, 1,
                              x_plus_delta);
   return AllFinite(x_plus_delta, AmbientSize());
 }
@@ -594,8 +771,8 @@ bool StiefelProductManifold::Plus(const double* x, const double* delta,
         delta + static_cast<std::ptrdiff_t>(i) * tangent,
         v.data() + static_cast<std::ptrdiff_t>(i) * ambient);
   }
-  CERES_SESYNC_DISPATCH_ON_D(d(), PolarRetractionKernel, x, v.data(), r(), d(),
-                             n_, x_plus_delta);
+  CERES_SESYNC_DISPATCH_ON_D(d(), PolarKernel, x, v.data(), r(), d(), n_,
+                             x_plus_delta);
   return AllFinite(x_plus_delta, AmbientSize());
 }
 

@@ -15,9 +15,14 @@ DEFINE_string(init, "chordal",
 DECLARE_uint64(seed);  // Defined in generate_command.cc.
 DEFINE_int32(initial_rank, 0, "solve: initial staircase rank (0: d + 2).");
 DEFINE_int32(max_rank, 10, "solve: maximum staircase rank.");
-DEFINE_string(preconditioner, "cholesky",
-              "solve: truncated-CG preconditioner: cholesky|jacobi|none.");
+DEFINE_string(preconditioner, "q",
+              "solve: truncated-CG preconditioner: q (regularized Q, exact "
+              "Schur complement)|cholesky (of Q's sparse part)|jacobi|none.");
 DEFINE_double(max_time, 0, "solve: wall-clock limit in seconds (0: none).");
+DEFINE_double(gradient_tolerance, ceres_sesync::SolverOptions()
+                                      .relative_preconditioned_gradient_tolerance,
+              "solve: relative preconditioned gradient tolerance of the "
+              "local solver.");
 
 namespace ceres_sesync::tools {
 
@@ -41,8 +46,10 @@ int RunSolve(const Args& args) {
                  FLAGS_init.c_str());
     return kUsageOrInputError;
   }
-  if (FLAGS_preconditioner == "cholesky") {
-    options.preconditioner = SolverOptions::Preconditioner::kRegularizedCholesky;
+  if (FLAGS_preconditioner == "q") {
+    options.preconditioner = SolverOptions::Preconditioner::kRegularizedQ;
+  } else if (FLAGS_preconditioner == "cholesky") {
+    options.preconditioner = SolverOptions::Preconditioner::kSparseCholesky;
   } else if (FLAGS_preconditioner == "jacobi") {
     options.preconditioner = SolverOptions::Preconditioner::kBlockJacobi;
   } else if (FLAGS_preconditioner == "none") {
@@ -57,6 +64,7 @@ int RunSolve(const Args& args) {
   options.max_rank = FLAGS_max_rank;
   options.max_time_s = FLAGS_max_time;
   options.verbose = FLAGS_verbose;
+  options.relative_preconditioned_gradient_tolerance = FLAGS_gradient_tolerance;
 
   const std::string& path = args[0];
   PoseGraph graph;

@@ -60,7 +60,7 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
       }
     }
   }
-  QuietCholmod(&factor_);
+  ConfigureCholmod(/*supernodal=*/true, &factor_);
   factor_.analyzePattern(K_);
 }
 
@@ -86,6 +86,13 @@ void CertificateMatrix::SolveShifted(const Eigen::VectorXd& y,
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(K_.rows());
   rhs.tail(rotation_size_) = y;
   *x = factor_.solve(rhs).tail(rotation_size_);
+}
+
+void CertificateMatrix::SolveShifted(const Eigen::MatrixXd& Y,
+                                     Eigen::MatrixXd* X) const {
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(K_.rows(), Y.cols());
+  rhs.bottomRows(rotation_size_) = Y;
+  *X = factor_.solve(rhs).bottomRows(rotation_size_);
 }
 
 }  // namespace ceres_sesync::internal

@@ -33,6 +33,8 @@ class CertificateMatrix {
 
   // After a successful Factorize(): x = (S + cI)^{-1} y, y and x in R^{dn}.
   void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;
+  // The same for the columns of Y (dn x k).
+  void SolveShifted(const Eigen::MatrixXd& Y, Eigen::MatrixXd* X) const;
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }

@@ -34,12 +34,18 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
     }
     return;
   }
+  if (type == PreconditionerType::kRegularizedQ) {
+    augmented_ = std::make_unique<CertificateMatrix>(problem);
+    CHECK(augmented_->Factorize(Eigen::MatrixXd::Zero(d, d * n), eps))
+        << "regularized Q preconditioner: factorization failed";
+    return;
+  }
   SparseMatrix regularized = D;
   for (int k = 0; k < regularized.rows(); ++k) {
     regularized.coeffRef(k, k) += eps;
   }
   factor_ = std::make_unique<CholmodFactor>();
-  QuietCholmod(factor_.get());
+  ConfigureCholmod(/*supernodal=*/false, factor_.get());
   factor_->compute(regularized);
   CHECK(factor_->info() == Eigen::Success)
       << "regularized Cholesky preconditioner failed";
@@ -54,9 +60,15 @@ void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
     case PreconditionerType::kBlockJacobi:
       BlockDiagonalMultiply(V, block_inverses_, d_, X);
       return;
-    case PreconditionerType::kRegularizedCholesky:
+    case PreconditionerType::kSparseCholesky:
       *X = factor_->solve(V.transpose()).transpose();
       return;
+    case PreconditionerType::kRegularizedQ: {
+      Eigen::MatrixXd Xt;
+      augmented_->SolveShifted(Eigen::MatrixXd(V.transpose()), &Xt);
+      *X = Xt.transpose();
+      return;
+    }
   }
 }
 

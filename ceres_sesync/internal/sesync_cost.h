@@ -7,15 +7,24 @@
 
 #include <memory>
 
+#include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/riemannian_trust_region.h"
 
 namespace ceres_sesync::internal {
 
-enum class PreconditionerType { kNone, kBlockJacobi, kRegularizedCholesky };
+enum class PreconditionerType {
+  kNone,
+  kBlockJacobi,          // Inverse diagonal blocks of D + eps I.
+  kSparseCholesky,       // (D + eps I)^{-1} by sparse Cholesky.
+  kRegularizedQ,         // (Q + eps I)^{-1} by sparse Cholesky of K_eps.
+};
 
-// Approximate inverse of D = L(G^rho) + Sigma~ (the sparse part of Q),
-// regularized as D + (lambda_max(D) / max_condition) I.
+// Approximate inverse of the Euclidean Hessian 2Q: either from
+// D = L(G^rho) + Sigma~ (the sparse part of Q) or exactly from Q through the
+// sparse translation-augmented matrix K_eps of certificate_matrix.h (its Schur
+// complement is Q + eps I). eps = lambda_max(D) / max_condition, where
+// lambda_max(D) >= lambda_max(Q) is bounded by Gershgorin.
 class SESyncPreconditioner {
  public:
   SESyncPreconditioner(const SESyncProblem& problem, PreconditionerType type,
@@ -29,6 +38,7 @@ class SESyncPreconditioner {
   PreconditionerType type_;
   Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.
   std::unique_ptr<CholmodFactor> factor_;
+  std::unique_ptr<CertificateMatrix> augmented_;
 };
 
 class SESyncCost : public RiemannianCostFunction {

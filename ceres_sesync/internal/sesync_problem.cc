@@ -8,7 +8,11 @@ namespace ceres_sesync::internal {
 
 using Triplet = Eigen::Triplet<double>;
 
-void QuietCholmod(CholmodFactor* factor) { factor->cholmod().print = 0; }
+void ConfigureCholmod(bool supernodal, CholmodFactor* factor) {
+  factor->setMode(supernodal ? Eigen::CholmodSupernodalLLt
+                             : Eigen::CholmodSimplicialLLt);
+  factor->cholmod().print = 0;
+}
 
 SESyncProblem::SESyncProblem(const PoseGraph& graph)
     : d_(graph.dimension), n_(graph.num_poses) {
@@ -63,7 +67,7 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph)
     return;
   }
   lbar_factor_ = std::make_unique<CholmodFactor>();
-  QuietCholmod(lbar_factor_.get());
+  ConfigureCholmod(/*supernodal=*/false, lbar_factor_.get());
   lbar_factor_->compute(Lbar_);
   ok_ = lbar_factor_->info() == Eigen::Success;
   LOG_IF(ERROR, !ok_) << "Cholesky factorization of the reduced translational "

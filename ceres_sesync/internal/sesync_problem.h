@@ -26,10 +26,13 @@
 namespace ceres_sesync::internal {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-using CholmodFactor = Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>;
+using CholmodFactor = Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>;
 
-// Silences CHOLMOD's own printing (failures are reported through info()).
-void QuietCholmod(CholmodFactor* factor);
+// Sets a true LL^T factorization (which fails on matrices that are not
+// positive definite, unlike LDL^T): simplicial (fast repeated solves with few
+// right-hand sides) or supernodal (fast factorization of larger factors), and
+// silences CHOLMOD's own printing (failures are reported through info()).
+void ConfigureCholmod(bool supernodal, CholmodFactor* factor);
 
 class SESyncProblem {
  public:
