@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace ceres_sesync {
 namespace {
@@ -111,7 +112,7 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
   summary->initial_cost = f;
   Eigen::MatrixXd g, pg, x_new;
   double radius = options.initial_trust_radius;
-  double reference_norm = 1;
+  double reference_norm = 1, initial_radius = 1;
   auto finish = [&](Termination t) {
     summary->termination = t;
     summary->final_cost = f;
@@ -143,6 +144,7 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
       // steepest-descent step -P g, a scale-free choice.
       radius = pg_norm;
     }
+    if (k == 0) initial_radius = radius;
     // Inner solve, then shrink the radius until a step is accepted.
     for (;;) {
       const TcgResult step =
@@ -163,7 +165,10 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
         radius *= 2;
       }
       const double step_norm = std::sqrt(Inner(step.eta, step.eta));
-      if (rho > 0.1 && std::isfinite(f_new) && f_new <= f) {
+      // Accept only decreases that stand above the round-off in f.
+      const double noise = 4 * std::numeric_limits<double>::epsilon() *
+                           std::abs(f);
+      if (rho > 0.1 && std::isfinite(f_new) && f - f_new > noise) {
         const double decrease = f - f_new;
         *x = x_new;
         f = f_new;
@@ -190,7 +195,8 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
       }
       // Rejected: restore the current point in the cost function.
       cost->Evaluate(*x);
-      if (step_norm <= options.step_tolerance || radius <= 1e-300) {
+      if (step_norm <= options.step_tolerance ||
+          radius <= 1e-12 * initial_radius) {
         summary->iterations = k + 1;
         return finish(Termination::kStepTolerance);
       }

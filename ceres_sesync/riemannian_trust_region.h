@@ -54,7 +54,9 @@ struct RiemannianTrustRegionOptions {
   double preconditioned_gradient_tolerance = 1e-6;
   // Stop when an accepted step decreases f by less than this fraction of |f|.
   double relative_decrease_tolerance = 1e-12;
-  // Stop when an accepted step has norm below this.
+  // Stop when a step has norm below this, or when rejections have shrunk the
+  // trust radius below 1e-12 times its initial value. Steps are accepted only
+  // if they decrease f by more than 4 machine epsilons of |f| (round-off).
   double step_tolerance = 1e-10;
   // Initial trust radius (in the preconditioner's norm); <= 0 means "from the
   // first Cauchy step".

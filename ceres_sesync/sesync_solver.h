@@ -66,9 +66,9 @@ struct SolverOptions {
   int max_inner_iterations = 10000;
   // Stop when the preconditioned gradient norm sqrt(<g, P g>) falls below
   // this fraction of sqrt(F(Y)) (scale-free; F has units of the weights).
-  double relative_preconditioned_gradient_tolerance = 1e-9;
+  double relative_preconditioned_gradient_tolerance = 1e-6;
   // Stop when an accepted step decreases F by less than this fraction of F.
-  double relative_decrease_tolerance = 1e-15;
+  double relative_decrease_tolerance = 1e-12;
 
   // Certification. S + eta I is tested with eta = eta_target, where
   // eta_target is the shift whose bound eta d n equals
@@ -79,7 +79,7 @@ struct SolverOptions {
   double certification_max_relative_bound = 1e-6;
   // Absolute floor on eta relative to max diag(Q's sparse part) (matters for
   // noiseless data where F(Y) = 0).
-  double min_relative_eta = 1e-12;
+  double min_relative_eta = 1e-16;
 
   // Wall-clock limit for the whole solve (<= 0: none).
   double max_time_s = 0;

@@ -229,32 +229,27 @@ void PolarKernel(const double* y, const double* v, int r, int d, int n,
   Small<D> gram;
   Small<D> m;
   std::unique_ptr<SvdPolar<D>> svd;  // Only for ill-conditioned blocks.
-  std::unique_ptr<Tall<D>> copy;
+  // Workspace for x = Y_i + V_i (one allocation per call).
+  Tall<D> x(r, D);
+  double* xp = x.data();
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(r) * D;
-  // Gram matrix of the r x D column-major block a (+ b if not null).
-  auto gram_of = [r](const double* a, const double* b, Small<D>* g) {
+  // Gram matrix of the r x D column-major block a.
+  auto gram_of = [r](const double* a, Small<D>* g) {
     double acc[D][D] = {};
     for (int j = 0; j < r; ++j) {
-      double row[D];
       for (int k = 0; k < D; ++k) {
-        row[k] = a[j + k * r] + (b != nullptr ? b[j + k * r] : 0.0);
-      }
-      for (int k = 0; k < D; ++k) {
-        for (int l = k; l < D; ++l) acc[k][l] += row[k] * row[l];
+        for (int l = k; l < D; ++l) acc[k][l] += a[j + k * r] * a[j + l * r];
       }
     }
     for (int k = 0; k < D; ++k) {
       for (int l = k; l < D; ++l) (*g)(k, l) = (*g)(l, k) = acc[k][l];
     }
   };
-  // o = (a + b) * c, row by row (o may alias a or b).
-  auto multiply = [r](const double* a, const double* b, const Small<D>& c,
-                      double* o) {
+  // o = a * c, row by row (o may alias a).
+  auto multiply = [r](const double* a, const Small<D>& c, double* o) {
     for (int j = 0; j < r; ++j) {
       double row[D];
-      for (int k = 0; k < D; ++k) {
-        row[k] = a[j + k * r] + (b != nullptr ? b[j + k * r] : 0.0);
-      }
+      for (int k = 0; k < D; ++k) row[k] = a[j + k * r];
       for (int k = 0; k < D; ++k) {
         double sum = 0.0;
         for (int l = 0; l < D; ++l) sum += row[l] * c(l, k);
@@ -264,28 +259,28 @@ void PolarKernel(const double* y, const double* v, int r, int d, int n,
   };
   for (int i = 0; i < n; ++i) {
     const double* y_i = y + i * stride;
-    const double* v_i = v != nullptr ? v + i * stride : nullptr;
+    if (v != nullptr) {
+      const double* v_i = v + i * stride;
+      for (std::ptrdiff_t k = 0; k < stride; ++k) xp[k] = y_i[k] + v_i[k];
+    } else {
+      std::copy(y_i, y_i + stride, xp);
+    }
     double* out_i = out + i * stride;
-    gram_of(y_i, v_i, &gram);
+    gram_of(xp, &gram);
     if (!inverse_sqrt.Compute(gram, &m)) {
-      if (!svd) {
-        svd = std::make_unique<SvdPolar<D>>(r, D);
-        copy = std::make_unique<Tall<D>>(r, D);
-      }
-      *copy = ConstBlock<D>(y_i, r, D);
-      if (v_i != nullptr) *copy += ConstBlock<D>(v_i, r, D);
+      if (!svd) svd = std::make_unique<SvdPolar<D>>(r, D);
       MutableBlock<D> out_map(out_i, r, D);
-      svd->Compute(*copy, &out_map);
+      svd->Compute(x, &out_map);
       continue;
     }
-    multiply(y_i, v_i, m, out_i);
+    multiply(xp, m, out_i);
     for (int step = 0; step < 3; ++step) {
-      gram_of(out_i, nullptr, &gram);
+      gram_of(out_i, &gram);
       gram.diagonal().array() -= 1.0;
       if (!(gram.cwiseAbs().maxCoeff() > kPolishThreshold)) break;
       m = -0.5 * gram;
       m.diagonal().array() += 1.0;
-      multiply(out_i, nullptr, m, out_i);
+      multiply(out_i, m, out_i);
     }
   }
 }
