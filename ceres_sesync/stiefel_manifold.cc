@@ -101,9 +101,9 @@ class SvdPolar {
 constexpr double kMinEigenvalueRatio = 1e-4;  // cond(x) < 100.
 
 // Newton-Schulz polishing stops once max |Q^T Q - I| is below this: a few
-// ulps, the rounding floor of evaluating Q^T Q itself (and 20x below the
-// 1e-14 orthonormality the solver relies on).
-constexpr double kPolishThreshold = 1e-15;
+// ulps above the rounding floor of evaluating Q^T Q itself, and well below
+// the 1e-14 orthonormality the solver relies on.
+constexpr double kPolishThreshold = 4e-15;
 
 template <int D>
 class InverseSqrt {

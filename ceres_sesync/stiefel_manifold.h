@@ -25,10 +25,12 @@
 //   R_Y(V) = (Y + V) (I_d + V^T V)^(-1/2)      (blockwise),
 //
 // i.e. the polar factor of Y + V, which for a tangent V is also the nearest
-// point of St(d, r) to Y + V (a second-order retraction). It is computed from
-// a d x d symmetric eigendecomposition followed by one Newton-Schulz
-// polishing step, so the result is orthonormal to ~1e-15 even for large
-// steps.
+// point of St(d, r) to Y + V (a second-order retraction). Per block it costs
+// one d x d Gram matrix G = (Y_i + V_i)^T (Y_i + V_i), a closed-form G^(-1/2)
+// (d = 2, 3; an eigendecomposition otherwise), one r x d x d product and
+// usually one Newton-Schulz polishing step, so the result is orthonormal to
+// < 5e-15 even for large steps. Blocks with cond(Y_i + V_i) > 100 (never for
+// a tangent V with ||V_i||_2 < 99) fall back to an SVD.
 
 #ifndef CERES_SESYNC_STIEFEL_MANIFOLD_H_
 #define CERES_SESYNC_STIEFEL_MANIFOLD_H_
@@ -82,15 +84,17 @@ void ProjectToStiefelProductTangent(const Eigen::MatrixXd& Y,
 // (For a tangent V, (Y_i + V_i)^T (Y_i + V_i) = I + V_i^T V_i; the
 // implementation uses the left-hand form (Y_i + V_i) ((Y_i + V_i)^T
 // (Y_i + V_i))^(-1/2), which is the polar factor for any V with Y_i + V_i of
-// full column rank.) The output is orthonormal to ~1e-15.
+// full column rank.) The output is orthonormal to < 5e-15.
 // `out` may alias Y or V.
 void RetractStiefelProduct(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,
                            int d, Eigen::MatrixXd* out);
 
 // Nearest point of St(d, r)^n to X in the Frobenius norm: the orthogonal
-// polar factor U_i W_i^T of each block, from a thin SVD X_i = U_i S_i W_i^T.
-// For a rank-deficient block the result is still orthonormal (one of the
-// nearest points). `out` may alias X.
+// polar factor U_i W_i^T of each block (X_i = U_i S_i W_i^T a thin SVD).
+// Computed like the retraction (closed-form inverse square root of X_i^T X_i
+// plus polishing), with an SVD for blocks of condition number > 100. For a
+// rank-deficient block the result is still orthonormal (one of the nearest
+// points). `out` may alias X.
 void ProjectToStiefelProduct(const Eigen::MatrixXd& X, int d,
                              Eigen::MatrixXd* out);
 
@@ -98,7 +102,8 @@ void ProjectToStiefelProduct(const Eigen::MatrixXd& X, int d,
 // Q factor of the thin QR of an r x d standard Gaussian matrix, with the sign
 // of each column chosen so that diag(R) > 0 (Mezzadri 2007). The Gaussians
 // are generated from the raw 64-bit output of `rng` (Box-Muller), so the
-// result is deterministic for a given rng state on every platform. Returns an
+// result is deterministic for a given rng state and does not depend on the
+// standard library's distribution implementations. Returns an
 // empty matrix if the sizes are invalid (d < 1, r < d, n < 0) or rng is null.
 Eigen::MatrixXd RandomStiefelProductPoint(int d, int r, int n,
                                           std::mt19937_64* rng);

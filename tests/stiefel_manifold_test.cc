@@ -223,12 +223,13 @@ TEST_P(StiefelProductFreeFunctions, RetractionStaysOnManifoldAndIsPolarFactor) {
   // R_Y(0) = Y.
   RetractStiefelProduct(y, MatrixXd::Zero(y.rows(), y.cols()), s.d, &out);
   EXPECT_LT((out - y).cwiseAbs().maxCoeff(), 1e-15 * 10);
-  for (double step : {1e-8, 1e-3, 0.1, 1.0, 10.0, 50.0}) {
+  for (double step : {1e-8, 1e-3, 0.1, 1.0, 10.0, 50.0, 1000.0}) {
     MatrixXd v;
     ProjectToStiefelProductTangent(y, Gaussian(s.r, s.d * s.n, &rng), s.d, &v);
     v *= step / std::sqrt(static_cast<double>(s.n));
     RetractStiefelProduct(y, v, s.d, &out);
-    // The brief: orthonormal to 1e-14 for any step size.
+    // Orthonormal to 1e-14 for any step size (the largest steps exercise the
+    // SVD fallback for blocks with cond(Y_i + V_i) > 100).
     EXPECT_LT(StiefelProductOrthonormalityError(out, s.d), 1e-14) << step;
     // The polar retraction is the nearest point of St(d,r)^n to Y + V.
     const MatrixXd expected = ReferenceProjectToProduct(y + v, s.d);
@@ -288,6 +289,20 @@ TEST_P(StiefelProductFreeFunctions, ProjectionToManifoldIsPolarFactor) {
   MatrixXd x_copy = x;
   ProjectToStiefelProduct(x_copy, s.d, &x_copy);
   EXPECT_LT((x_copy - out).cwiseAbs().maxCoeff(), 1e-15);
+  // Ill-conditioned blocks: condition 50 (closed-form path) and 1e5 (SVD
+  // fallback) both match the reference polar factor. The polar factor's
+  // sensitivity is ~1/sigma_min, so allow 1e-12 * cond.
+  for (double cond : {50.0, 1e5}) {
+    const MatrixXd u = ReferencePolar(Gaussian(s.r, s.d, &rng));
+    const MatrixXd w = ReferencePolar(Gaussian(s.d, s.d, &rng));
+    const Eigen::VectorXd sigma =
+        Eigen::VectorXd::LinSpaced(s.d, 1.0, 1.0 / cond);
+    const MatrixXd block = u * sigma.asDiagonal() * w.transpose();
+    ProjectToStiefelProduct(block, s.d, &out);
+    EXPECT_LT((out - ReferencePolar(block)).cwiseAbs().maxCoeff(), 1e-12 * cond)
+        << cond;
+    EXPECT_LT(StiefelProductOrthonormalityError(out, s.d), 1e-14) << cond;
+  }
   // A rank-deficient block (zero and rank one) still gives an orthonormal
   // block.
   MatrixXd deficient = x;
