@@ -32,7 +32,8 @@ bool IsRotation(const Eigen::MatrixXd& R, int d, double tolerance) {
   if (R.rows() != d || R.cols() != d || !R.allFinite()) return false;
   const double orthogonality =
       (R.transpose() * R - Eigen::MatrixXd::Identity(d, d)).norm();
-  return orthogonality <= tolerance && std::abs(R.determinant() - 1) <= tolerance;
+  return orthogonality <= tolerance &&
+         std::abs(R.determinant() - 1) <= tolerance;
 }
 }  // namespace
 

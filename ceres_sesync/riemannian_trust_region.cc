@@ -13,8 +13,8 @@ double Inner(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
 }
 
 struct TcgResult {
-  Eigen::MatrixXd eta;     // The step.
-  Eigen::MatrixXd h_eta;   // Hessian times the step.
+  Eigen::MatrixXd eta;    // The step.
+  Eigen::MatrixXd h_eta;  // Hessian times the step.
   int iterations = 0;
   bool hit_boundary = false;
 };
@@ -48,8 +48,8 @@ TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
     if (d_hd <= 0 || e_pe_new >= radius2 || !std::isfinite(alpha)) {
       // Move to the boundary along delta.
       const double tau =
-          (-e_pd + std::sqrt(std::max(0.0, e_pd * e_pd +
-                                               d_pd * (radius2 - e_pe)))) /
+          (-e_pd +
+           std::sqrt(std::max(0.0, e_pd * e_pd + d_pd * (radius2 - e_pe)))) /
           d_pd;
       out.eta += tau * delta;
       out.h_eta += tau * h_delta;
@@ -166,8 +166,8 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
       }
       const double step_norm = std::sqrt(Inner(step.eta, step.eta));
       // Accept only decreases that stand above the round-off in f.
-      const double noise = 4 * std::numeric_limits<double>::epsilon() *
-                           std::abs(f);
+      const double noise =
+          4 * std::numeric_limits<double>::epsilon() * std::abs(f);
       if (rho > 0.1 && std::isfinite(f_new) && f - f_new > noise) {
         const double decrease = f - f_new;
         *x = x_new;

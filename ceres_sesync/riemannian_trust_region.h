@@ -25,8 +25,7 @@ class RiemannianCostFunction {
   // Riemannian gradient at the current point.
   virtual void Gradient(Eigen::MatrixXd* gradient) = 0;
   // Riemannian Hessian at the current point applied to the tangent vector v.
-  virtual void HessianVector(const Eigen::MatrixXd& v,
-                             Eigen::MatrixXd* hv) = 0;
+  virtual void HessianVector(const Eigen::MatrixXd& v, Eigen::MatrixXd* hv) = 0;
   // Applies a symmetric positive definite preconditioner (an approximation of
   // the inverse Hessian) to the tangent vector v; the result must be tangent.
   // The default is the identity.

@@ -127,21 +127,21 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
              SolverOptions::Initialization::kVertices) {
     if (graph.initial_poses.empty()) {
       s.status = SolverSummary::Status::kInvalidInput;
-      s.message = "initialization from vertices requested, but the graph has "
-                  "no initial poses";
+      s.message =
+          "initialization from vertices requested, but the graph has "
+          "no initial poses";
       return {};
     }
     for (int i = 0; i < n; ++i) {
       Y.block(0, d * i, d, d) = graph.initial_poses[i].R;
     }
-  } else if (options.initialization ==
-             SolverOptions::Initialization::kRandom) {
+  } else if (options.initialization == SolverOptions::Initialization::kRandom) {
     std::mt19937_64 rng(options.seed);
     Y = RandomStiefelProductPoint(d, r0, n, &rng);
   } else {
     Eigen::MatrixXd R;
-    if (!internal::ChordalRotationsFromLaplacian(problem.RotationLaplacian(),
-                                                 d, &R)) {
+    if (!internal::ChordalRotationsFromLaplacian(problem.RotationLaplacian(), d,
+                                                 &R)) {
       s.status = SolverSummary::Status::kInvalidInput;
       s.message = "chordal initialization failed";
       return {};
@@ -188,9 +188,8 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
       level.termination = rtr_summary.TerminationString();
       const double previous = f;
       f = rtr_summary.final_cost;
-      if (rtr_summary.termination !=
-              RiemannianTrustRegionSummary::Termination::
-                  kPreconditionedGradientTolerance ||
+      if (rtr_summary.termination != RiemannianTrustRegionSummary::Termination::
+                                         kPreconditionedGradientTolerance ||
           f >= 0.5 * previous) {
         break;
       }
@@ -205,13 +204,14 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
     // Verify.
     t = Clock::now();
     const double eta_floor = options.min_relative_eta * scale;
-    const double eta_target = std::max(
-        eta_floor,
-        options.certification_target_relative_bound * sdp_value / (d * n));
-    const double eta_max = std::max(
-        eta_floor, options.certification_max_relative_bound * sdp_value / (d * n));
-    verification = internal::VerifyCertificate(problem, cost.Lambda(),
-                                               eta_target, eta_max, &certificate);
+    const double eta_target =
+        std::max(eta_floor, options.certification_target_relative_bound *
+                                sdp_value / (d * n));
+    const double eta_max =
+        std::max(eta_floor, options.certification_max_relative_bound *
+                                sdp_value / (d * n));
+    verification = internal::VerifyCertificate(
+        problem, cost.Lambda(), eta_target, eta_max, &certificate);
     level.verify_time_s = Seconds(t);
     level.certified = verification.certified;
     level.eta = verification.eta;
@@ -252,8 +252,8 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
     V.row(r) = verification.direction.transpose();
     double max_block_norm = 0;
     for (int i = 0; i < n; ++i) {
-      max_block_norm =
-          std::max(max_block_norm, verification.direction.segment(d * i, d).norm());
+      max_block_norm = std::max(
+          max_block_norm, verification.direction.segment(d * i, d).norm());
     }
     double alpha = 1.0 / max_block_norm;
     bool escaped = false;
@@ -359,8 +359,8 @@ std::string SolverSummary::FullReport() const {
     return out;
   }
   out += "\nRiemannian staircase\n";
-  line("  %4s %6s %8s %18s %11s %11s %11s %s\n", "rank", "iters", "Hv",
-       "F(Y)", "|grad F|", "eta", "lambda_min", "termination");
+  line("  %4s %6s %8s %18s %11s %11s %11s %s\n", "rank", "iters", "Hv", "F(Y)",
+       "|grad F|", "eta", "lambda_min", "termination");
   for (const Level& l : levels) {
     line("  %4d %6d %8d %18.12g %11.3e %11.3e %11.3e %s%s\n", l.rank,
          l.iterations, l.hessian_vector_products, l.sdp_value, l.gradient_norm,

@@ -1,13 +1,85 @@
-#include <cstdio>
+// `ceres_sesync certify GRAPH.g2o POSES.g2o`: certify a given solution.
 
+#include <cstdio>
+#include <iostream>
+
+#include "ceres_sesync/certification.h"
+#include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/internal/json_writer.h"
+#include "gflags/gflags.h"
 #include "tools/commands.h"
+
+DEFINE_double(max_relative_suboptimality,
+              ceres_sesync::CertifyOptions().max_relative_suboptimality,
+              "certify: certified iff the proven relative suboptimality bound "
+              "is at most this.");
+DEFINE_bool(improve, false,
+            "certify: if not certified, run SE-Sync from the candidate and "
+            "write the improved poses to --output.");
 
 namespace ceres_sesync::tools {
 
-// Placeholder until the owning issue lands.
-int RunCertify(const Args&) {
-  std::fputs("ceres_sesync certify: not implemented yet\n", stderr);
-  return kUsageOrInputError;
+int RunCertify(const Args& args) {
+  if (args.size() != 2) {
+    std::fputs(
+        "usage: ceres_sesync certify GRAPH.g2o POSES.g2o "
+        "[--json CERT.json] [--improve --output IMPROVED.g2o]\n",
+        stderr);
+    return kUsageOrInputError;
+  }
+  PoseGraph graph;
+  std::string error;
+  if (!ReadG2oFile(args[0], G2oReadOptions(), &graph, &error)) {
+    std::fprintf(stderr, "ceres_sesync certify: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  Poses poses;
+  if (!ReadG2oPoses(args[1], graph, &poses, &error)) {
+    std::fprintf(stderr, "ceres_sesync certify: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  CertifyOptions options;
+  options.max_relative_suboptimality = FLAGS_max_relative_suboptimality;
+  options.improve_if_not_certified = FLAGS_improve;
+  Certificate certificate;
+  if (!Certify(graph, poses, options, &certificate, &error)) {
+    std::fprintf(stderr, "ceres_sesync certify: %s: %s\n", args[1].c_str(),
+                 error.c_str());
+    return kUsageOrInputError;
+  }
+  std::cout << certificate.FullReport() << std::flush;
+  if (certificate.has_improved_poses && !FLAGS_output.empty() &&
+      !WriteG2oPoses(FLAGS_output, graph, certificate.improved_poses, &error)) {
+    std::fprintf(stderr, "ceres_sesync certify: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  if (!FLAGS_json.empty()) {
+    internal::JsonWriter json;
+    json.String("graph", args[0]);
+    json.String("poses", args[1]);
+    json.Number("objective", certificate.objective);
+    json.Number("rotation_objective", certificate.rotation_objective);
+    json.Number("lambda_min", certificate.lambda_min);
+    json.Number("eta", certificate.eta);
+    json.Number("lower_bound", certificate.lower_bound);
+    json.Number("suboptimality_bound", certificate.suboptimality_bound);
+    json.Number("relative_suboptimality_bound",
+                certificate.relative_suboptimality_bound);
+    json.Bool("certified", certificate.certified);
+    json.Number("negative_curvature", certificate.negative_curvature);
+    json.Number("time_s", certificate.time_s);
+    if (certificate.has_improved_poses) {
+      json.Number("improved_objective",
+                  certificate.improvement_summary.objective);
+      json.Bool("improved_certified",
+                certificate.improvement_summary.certified());
+    }
+    if (!json.WriteToFile(FLAGS_json, &error)) {
+      std::fprintf(stderr, "ceres_sesync certify: %s\n", error.c_str());
+      return kUsageOrInputError;
+    }
+  }
+  return certificate.certified ? kSuccess : kNotCertified;
 }
 
 }  // namespace ceres_sesync::tools

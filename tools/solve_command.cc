@@ -19,19 +19,21 @@ DEFINE_string(preconditioner, "q",
               "solve: truncated-CG preconditioner: q (regularized Q, exact "
               "Schur complement)|cholesky (of Q's sparse part)|jacobi|none.");
 DEFINE_double(max_time, 0, "solve: wall-clock limit in seconds (0: none).");
-DEFINE_double(gradient_tolerance, ceres_sesync::SolverOptions()
-                                      .relative_preconditioned_gradient_tolerance,
-              "solve: relative preconditioned gradient tolerance of the "
-              "local solver.");
+DEFINE_double(
+    gradient_tolerance,
+    ceres_sesync::SolverOptions().relative_preconditioned_gradient_tolerance,
+    "solve: relative preconditioned gradient tolerance of the "
+    "local solver.");
 
 namespace ceres_sesync::tools {
 
 int RunSolve(const Args& args) {
   if (args.size() != 1) {
-    std::fputs("usage: ceres_sesync solve GRAPH.g2o [--output POSES.g2o] "
-               "[--tum FILE] [--json SUMMARY.json] "
-               "[--init chordal|random|vertices] [--verbose]\n",
-               stderr);
+    std::fputs(
+        "usage: ceres_sesync solve GRAPH.g2o [--output POSES.g2o] "
+        "[--tum FILE] [--json SUMMARY.json] "
+        "[--init chordal|random|vertices] [--verbose]\n",
+        stderr);
     return kUsageOrInputError;
   }
   SolverOptions options;

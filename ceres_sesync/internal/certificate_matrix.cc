@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "glog/logging.h"
+
 namespace ceres_sesync::internal {
 
 using Triplet = Eigen::Triplet<double>;
@@ -78,7 +80,11 @@ bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c) {
     }
   }
   factor_.factorize(K_);
-  return factor_.info() == Eigen::Success;
+  if (factor_.info() != Eigen::Success) return false;
+  backward_error_ = factor_.BackwardErrorBound();
+  proven_shift_ = c + backward_error_;
+  VLOG(1) << "K_c factorized: c " << c << " backward error " << backward_error_;
+  return true;
 }
 
 void CertificateMatrix::SolveShifted(const Eigen::VectorXd& y,

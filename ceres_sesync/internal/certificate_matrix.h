@@ -10,9 +10,9 @@
 //
 // so S + cI is positive definite if and only if K_c is, and a sparse Cholesky
 // factorization of K_c that succeeds proves lambda_min(S) > -c (up to the
-// floating-point backward error of the factorization, which
-// Factorize() bounds; see BackwardErrorBound()). The same factorization
-// applies (S + cI)^{-1}, which the shift-and-invert eigensolver uses.
+// floating-point backward error of the factorization, which Factorize()
+// accounts for: see proven_shift()). The same factorization applies
+// (S + cI)^{-1}, which the shift-and-invert eigensolver uses.
 
 #ifndef CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 #define CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
@@ -36,6 +36,15 @@ class CertificateMatrix {
   // The same for the columns of Y (dn x k).
   void SolveShifted(const Eigen::MatrixXd& Y, Eigen::MatrixXd* X) const;
 
+  // After a successful Factorize(Lambda, c): c + delta, where delta bounds
+  // the factorization's backward error ||L L^T - P K_c P^T||_2 (see
+  // CholmodFactor::BackwardErrorBound), so K_c + delta I is proven positive
+  // semidefinite. Round-off in the translation block (rows of Lbar) reaches S
+  // amplified by ||Lbar^{-1} Vbar||^2; that worst case is not added (see
+  // certification.h, "Floating point").
+  double proven_shift() const { return proven_shift_; }
+  double backward_error() const { return backward_error_; }
+
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }
 
@@ -45,6 +54,8 @@ class CertificateMatrix {
   std::vector<double> base_values_;  // K_0 without Lambda.
   std::vector<int> block_entry_;     // Value index of each (i, a >= b).
   CholmodFactor factor_;
+  double proven_shift_ = 0;
+  double backward_error_ = 0;
 };
 
 }  // namespace ceres_sesync::internal

@@ -7,8 +7,8 @@
 namespace ceres_sesync::internal {
 
 Eigen::MatrixXd ProjectToRotation(const Eigen::MatrixXd& M) {
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(M,
-                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(
+      M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::MatrixXd U = svd.matrixU();
   if ((U * svd.matrixV().transpose()).determinant() < 0) {
     U.col(U.cols() - 1) *= -1;

@@ -91,8 +91,7 @@ void SESyncCost::Gradient(Eigen::MatrixXd* gradient) {
   *gradient = 2 * (YQ_ - *gradient);
 }
 
-void SESyncCost::HessianVector(const Eigen::MatrixXd& V,
-                               Eigen::MatrixXd* hv) {
+void SESyncCost::HessianVector(const Eigen::MatrixXd& V, Eigen::MatrixXd* hv) {
   // Eq. (44): Proj_Y(2 V Q - V_i SymBlockDiag(Y^T 2 Y Q)_i).
   ++hessian_vector_products_;
   Eigen::MatrixXd VQ, V_lambda;

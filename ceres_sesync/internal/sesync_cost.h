@@ -15,9 +15,9 @@ namespace ceres_sesync::internal {
 
 enum class PreconditionerType {
   kNone,
-  kBlockJacobi,          // Inverse diagonal blocks of D + eps I.
-  kSparseCholesky,       // (D + eps I)^{-1} by sparse Cholesky.
-  kRegularizedQ,         // (Q + eps I)^{-1} by sparse Cholesky of K_eps.
+  kBlockJacobi,     // Inverse diagonal blocks of D + eps I.
+  kSparseCholesky,  // (D + eps I)^{-1} by sparse Cholesky.
+  kRegularizedQ,    // (Q + eps I)^{-1} by sparse Cholesky of K_eps.
 };
 
 // Approximate inverse of the Euclidean Hessian 2Q: either from

@@ -1,5 +1,8 @@
 #include "ceres_sesync/internal/sesync_problem.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "glog/logging.h"
@@ -7,6 +10,42 @@
 namespace ceres_sesync::internal {
 
 using Triplet = Eigen::Triplet<double>;
+
+double CholmodFactor::BackwardErrorBound() {
+  cholmod_common* common = &cholmod();
+  cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, common);
+  CHECK(L != nullptr) << "out of memory copying the Cholesky factor";
+  // Simplicial, LL^T, packed: plain compressed columns.
+  cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0,
+                        /*to_packed=*/1, /*to_monotonic=*/1, L, common);
+  const int n = static_cast<int>(L->n);
+  const int* p = static_cast<const int*>(L->p);
+  const int* row = static_cast<const int*>(L->i);
+  const double* x = static_cast<const double*>(L->x);
+  std::vector<double> column_sum(n, 0.0), v(n, 0.0);
+  std::vector<int> row_count(n, 0);
+  for (int j = 0; j < n; ++j) {
+    for (int k = p[j]; k < p[j + 1]; ++k) {
+      column_sum[j] += std::abs(x[k]);
+      ++row_count[row[k]];
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int k = p[j]; k < p[j + 1]; ++k) {
+      v[row[k]] += std::abs(x[k]) * column_sum[j];
+    }
+  }
+  cholmod_free_factor(&L, common);
+  // Entry (i, j) of L L^T sums at most min(k_i, k_j) products (k_i = nonzeros
+  // in row i), so row i of the error is bounded by gamma_{k_i + 1} v_i.
+  const double unit_roundoff = std::numeric_limits<double>::epsilon() / 2;
+  double bound = 0;
+  for (int i = 0; i < n; ++i) {
+    const double m = 4.0 * (row_count[i] + 1);
+    bound = std::max(bound, m * unit_roundoff / (1 - m * unit_roundoff) * v[i]);
+  }
+  return bound;
+}
 
 void ConfigureCholmod(bool supernodal, CholmodFactor* factor) {
   factor->setMode(supernodal ? Eigen::CholmodSupernodalLLt

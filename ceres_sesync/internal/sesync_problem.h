@@ -26,7 +26,21 @@
 namespace ceres_sesync::internal {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-using CholmodFactor = Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>;
+// CHOLMOD's Cholesky factorization (through Eigen) plus an a posteriori bound
+// on its floating-point backward error.
+class CholmodFactor
+    : public Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> {
+ public:
+  // After a successful factorization P A P^T = L L^T: a bound delta on
+  // ||L L^T - P A P^T||_2, so that A + delta I is positive semidefinite.
+  // Uses the componentwise bound |L L^T - P A P^T| <= gamma_{k+1} |L| |L^T|
+  // for Cholesky (Demmel 1989; Higham, "Accuracy and Stability of Numerical
+  // Algorithms", Thm. 10.5), applied row by row with k the number of nonzeros
+  // in the row of L and gamma widened by a factor 4 for blocked (supernodal)
+  // summation orders, and ||E||_2 <= ||E||_inf for the symmetric error E.
+  // O(nnz(L)) plus a copy of the factor.
+  double BackwardErrorBound();
+};
 
 // Sets a true LL^T factorization (which fails on matrices that are not
 // positive definite, unlike LDL^T): simplicial (fast repeated solves with few

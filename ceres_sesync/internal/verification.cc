@@ -60,9 +60,10 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   result.lambda_min_estimate = std::numeric_limits<double>::quiet_NaN();
   const int d = problem.dimension();
   ++result.factorizations;
-  if (matrix->Factorize(Lambda, eta_target)) {
+  if (matrix->Factorize(Lambda, eta_target) &&
+      matrix->proven_shift() <= eta_max) {
     result.certified = true;
-    result.eta = eta_target;
+    result.eta = matrix->proven_shift();
     return result;
   }
   // Bracket lambda_min(S) from below: S + cI is PD for c > lambda_max(Lambda).
@@ -83,13 +84,12 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     result.eigensolver_failed = true;
     return result;
   }
-  result.eta = c;
+  result.eta = matrix->proven_shift();
   // lambda_min(S) > -c: the largest eigenvalue of (S + cI)^{-1} is
   // 1 / (lambda_min + c).
   ShiftInvertOperator op(matrix);
   const int dim = matrix->dimension();
-  Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1,
-                                                   std::min(20, dim));
+  Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1, std::min(20, dim));
   eigs.init();
   eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-8);
   if (eigs.info() == Spectra::CompInfo::Successful) {
@@ -100,18 +100,22 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     LOG(WARNING) << "shift-and-invert Lanczos did not converge";
   }
   if (result.direction.size() == dim) {
-    result.direction_curvature =
-        result.direction.dot(MultiplyCertificate(problem, Lambda, result.direction));
+    result.direction_curvature = result.direction.dot(
+        MultiplyCertificate(problem, Lambda, result.direction));
   }
-  if (c <= eta_max) {
-    // Within tolerance: tighten the slack to just above the estimate.
-    result.certified = true;
-    if (std::isfinite(result.lambda_min_estimate)) {
-      const double tight =
-          std::max(eta_target, -1.05 * result.lambda_min_estimate);
+  // Tighten the shift to just above the estimate when that can certify.
+  if (std::isfinite(result.lambda_min_estimate) && result.eta > eta_max) {
+    const double tight =
+        std::max(eta_target, -1.05 * result.lambda_min_estimate);
+    if (tight < c) {
       ++result.factorizations;
-      if (tight < c && matrix->Factorize(Lambda, tight)) result.eta = tight;
+      if (matrix->Factorize(Lambda, tight)) {
+        result.eta = std::min(result.eta, matrix->proven_shift());
+      }
     }
+  }
+  if (result.eta <= eta_max) {
+    result.certified = true;
     return result;
   }
   if (result.direction.size() != dim || !(result.direction_curvature < 0)) {

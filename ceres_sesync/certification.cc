@@ -1,0 +1,147 @@
+#include "ceres_sesync/certification.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "ceres_sesync/internal/certificate_matrix.h"
+#include "ceres_sesync/internal/rounding.h"
+#include "ceres_sesync/internal/sesync_problem.h"
+#include "ceres_sesync/internal/verification.h"
+#include "ceres_sesync/stiefel_manifold.h"
+#include "glog/logging.h"
+
+namespace ceres_sesync {
+
+bool Certify(const PoseGraph& graph, const Poses& candidate,
+             const CertifyOptions& options, Certificate* certificate,
+             std::string* error) {
+  const auto start = std::chrono::steady_clock::now();
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (!ValidatePoseGraph(graph, error)) return false;
+  const int d = graph.dimension, n = graph.num_poses;
+  if (static_cast<int>(candidate.size()) != n) {
+    return fail("candidate has " + std::to_string(candidate.size()) +
+                " poses, the graph has " + std::to_string(n));
+  }
+  Certificate c;
+  Poses projected = candidate;
+  Eigen::MatrixXd R(d, d * n);
+  for (int i = 0; i < n; ++i) {
+    const Pose& p = candidate[i];
+    if (p.R.rows() != d || p.R.cols() != d || p.t.size() != d) {
+      return fail("candidate pose " + std::to_string(i) + " (vertex " +
+                  std::to_string(graph.vertex_ids[i]) +
+                  ") has the wrong dimension");
+    }
+    if (!p.R.allFinite() || !p.t.allFinite()) {
+      return fail("candidate pose " + std::to_string(i) + " (vertex " +
+                  std::to_string(graph.vertex_ids[i]) + ") is not finite");
+    }
+    projected[i].R = internal::ProjectToRotation(p.R);
+    c.max_rotation_error =
+        std::max(c.max_rotation_error, (projected[i].R - p.R).norm());
+    R.middleCols(d * i, d) = projected[i].R;
+  }
+  LOG_IF(WARNING, c.max_rotation_error > options.rotation_warning_tolerance)
+      << "Certify: candidate rotations are up to " << c.max_rotation_error
+      << " (Frobenius) away from SO(" << d << "); certifying their projection";
+  c.objective = EvaluateObjective(graph, projected);
+  c.lambda_min = std::numeric_limits<double>::quiet_NaN();
+
+  if (n == 1) {  // No measurements: the single pose is trivially optimal.
+    c.certified = true;
+  } else {
+    const internal::SESyncProblem problem(graph);
+    if (!problem.ok()) return fail("the translational Laplacian is singular");
+    Eigen::MatrixXd RQ;
+    problem.MultiplyQ(R, &RQ);
+    const Eigen::MatrixXd Lambda = SymBlockDiagProduct(RQ, R, d);
+    double trace = 0;
+    for (int i = 0; i < d * n; ++i) trace += Lambda(i % d, i);
+    c.rotation_objective = trace;
+    // Largest eta for which the bound can still meet the tolerance:
+    // objective - (trace - eta d n) <= tol (trace - eta d n).
+    const double tol = options.max_relative_suboptimality;
+    const double eta_max =
+        (tol * trace - (c.objective - trace)) / (d * n * (1 + tol));
+    const double eta_target =
+        std::max(options.target_relative_bound * std::abs(trace) / (d * n),
+                 std::numeric_limits<double>::min());
+    internal::CertificateMatrix matrix(problem);
+    const internal::VerificationResult v = internal::VerifyCertificate(
+        problem, Lambda, eta_target, std::max(eta_max, 0.0), &matrix);
+    c.eta = v.eta;
+    c.lambda_min = v.lambda_min_estimate;
+    c.lower_bound = trace - v.eta * d * n;
+    c.certified = v.certified && eta_max > 0;
+    if (!v.certified && v.direction.size() == d * n &&
+        v.direction_curvature < 0) {
+      c.negative_curvature_direction = v.direction;
+      c.negative_curvature = v.direction_curvature;
+    }
+  }
+  if (!std::isfinite(c.lower_bound)) {
+    c.lower_bound = -std::numeric_limits<double>::infinity();
+  }
+  c.suboptimality_bound = c.objective - c.lower_bound;
+  c.relative_suboptimality_bound =
+      c.lower_bound > 0 ? c.suboptimality_bound / c.lower_bound
+                        : (c.suboptimality_bound <= 0
+                               ? 0
+                               : std::numeric_limits<double>::infinity());
+  c.time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  if (!c.certified && options.improve_if_not_certified) {
+    c.improved_poses =
+        Solve(graph, projected, options.solver_options, &c.improvement_summary);
+    c.has_improved_poses = !c.improved_poses.empty();
+  }
+  *certificate = std::move(c);
+  return true;
+}
+
+std::string Certificate::BriefReport() const {
+  char buf[512];
+  std::snprintf(buf, sizeof(buf),
+                "Certificate: %s, F = %.10g, lower bound %.10g, relative "
+                "suboptimality <= %.3e, eta %.3e, %.3f s",
+                certified ? "CERTIFIED" : "NOT CERTIFIED", objective,
+                lower_bound, relative_suboptimality_bound, eta, time_s);
+  return buf;
+}
+
+std::string Certificate::FullReport() const {
+  std::string out = "\nCertificate Report\n------------------\n";
+  char buf[512];
+  auto line = [&](const char* format, auto... args) {
+    std::snprintf(buf, sizeof(buf), format, args...);
+    out += buf;
+  };
+  line("%-36s %.12g\n", "Objective F(candidate)", objective);
+  line("%-36s %.12g\n", "F with optimal translations", rotation_objective);
+  line("%-36s %.3e\n", "lambda_min(S) estimate", lambda_min);
+  line("%-36s %.3e\n", "eta (S + eta I proven PSD)", eta);
+  line("%-36s %.12g\n", "Lower bound on the optimum", lower_bound);
+  line("%-36s %.3e\n", "Suboptimality bound", suboptimality_bound);
+  line("%-36s %.3e\n", "Relative suboptimality bound",
+       relative_suboptimality_bound);
+  line("%-36s %.3e\n", "Max rotation distance from SO(d)", max_rotation_error);
+  if (negative_curvature_direction.size() > 0) {
+    line("%-36s %.3e\n", "Negative curvature v^T S v", negative_curvature);
+  }
+  line("%-36s %.4f\n", "Time (s)", time_s);
+  line("%-36s %s\n", "Result", certified ? "CERTIFIED" : "NOT CERTIFIED");
+  if (has_improved_poses) {
+    out += "\nImproved solution (SE-Sync from the candidate):\n  " +
+           improvement_summary.BriefReport() + "\n";
+  }
+  return out;
+}
+
+}  // namespace ceres_sesync
