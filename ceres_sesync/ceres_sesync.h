@@ -1,0 +1,51 @@
+// Umbrella header: everything a user of ceres_sesync needs, in one include.
+//
+//   #include "ceres_sesync/ceres_sesync.h"
+//
+// The public API (each header documents its part):
+//
+//   pose_graph.h              The data model: PoseGraph,
+//   RelativePoseMeasurement,
+//                             Pose/Poses, EvaluateObjective (eq. 12),
+//                             ValidatePoseGraph.
+//   g2o_io.h                  Reading/writing g2o files, writing TUM
+//                             trajectories.
+//   sesync_solver.h           Solve(): SE-Sync, certifiably correct pose-graph
+//                             optimization (SolverOptions, SolverSummary).
+//   certification.h           Certify(): a global-optimality certificate or a
+//                             suboptimality bound for ANY solution, e.g. one
+//                             computed by Ceres.
+//   pose_conversions.h        Conversions to/from Eigen isometries,
+//                             quaternions, (x, y, yaw), and the pose maps and
+//                             constraint vectors of Ceres's examples/slam.
+//   ceres_baseline.h          The same objective minimized by Ceres
+//                             (SolveWithCeres, BuildCeresProblem), and the
+//                             odometry initialization.
+//   chordal_initialization.h  The chordal rotation initialization.
+//   cube_generator.h          The synthetic cube benchmark of the paper.
+//   langevin.h                The isotropic Langevin / von Mises noise
+//                             samplers used by the generator.
+//   stiefel_manifold.h        St(d, r) and St(d, r)^n: free functions and
+//                             ceres::Manifold classes.
+//   riemannian_trust_region.h The Riemannian trust-region solver used by
+//                             SE-Sync (usable for any matrix-manifold cost).
+//
+// Implementation details live in ceres_sesync/internal/ and are not part of
+// the API (not included here).
+
+#ifndef CERES_SESYNC_CERES_SESYNC_H_
+#define CERES_SESYNC_CERES_SESYNC_H_
+
+#include "ceres_sesync/ceres_baseline.h"
+#include "ceres_sesync/certification.h"
+#include "ceres_sesync/chordal_initialization.h"
+#include "ceres_sesync/cube_generator.h"
+#include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/langevin.h"
+#include "ceres_sesync/pose_conversions.h"
+#include "ceres_sesync/pose_graph.h"
+#include "ceres_sesync/riemannian_trust_region.h"
+#include "ceres_sesync/sesync_solver.h"
+#include "ceres_sesync/stiefel_manifold.h"
+
+#endif  // CERES_SESYNC_CERES_SESYNC_H_
