@@ -1,0 +1,426 @@
+// Independent tests of the SE-Sync data matrices (internal/sesync_problem.h)
+// and of the Burer-Monteiro cost (internal/sesync_cost.h).
+//
+// The reference for Q is built DENSELY in the test from first principles
+// (tests/util/test_graphs.h: the data matrix M assembled residual by residual,
+// then the Schur complement of its translation block), and cross-checked
+// against the paper's own formula Q = L(G^rho) + T^T Omega^1/2 Pi Omega^1/2 T
+// (Rosen et al. 2019, eq. 24) with Pi computed by an SVD. Derivatives of the
+// cost are checked by finite differences along retraction curves.
+
+#include "ceres_sesync/internal/sesync_problem.h"
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "Eigen/Dense"
+#include "ceres_sesync/internal/sesync_cost.h"
+#include "ceres_sesync/pose_graph.h"
+#include "ceres_sesync/stiefel_manifold.h"
+#include "gtest/gtest.h"
+#include "tests/util/test_graphs.h"
+
+namespace ceres_sesync {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using internal::PreconditionerType;
+using internal::SESyncCost;
+using internal::SESyncPreconditioner;
+using internal::SESyncProblem;
+using test_util::DenseQ;
+using test_util::DenseQFromPaper;
+using test_util::RandomGraphOptions;
+using test_util::RandomPoseGraph;
+
+double RelativeError(const MatrixXd& a, const MatrixXd& b) {
+  return (a - b).norm() / std::max(b.norm(), 1e-300);
+}
+
+MatrixXd Gaussian(int rows, int cols, std::mt19937_64* rng) {
+  std::normal_distribution<double> normal;
+  MatrixXd m(rows, cols);
+  for (Eigen::Index k = 0; k < m.size(); ++k) m.data()[k] = normal(*rng);
+  return m;
+}
+
+double Inner(const MatrixXd& a, const MatrixXd& b) {
+  return a.cwiseProduct(b).sum();
+}
+
+// A family of small graphs: 2D and 3D, trees, sparse and dense loop closures,
+// varied precisions (including strongly anisotropic kappa vs tau).
+std::vector<RandomGraphOptions> SmallGraphFamily() {
+  std::vector<RandomGraphOptions> family;
+  uint64_t seed = 1;
+  for (int d : {2, 3}) {
+    for (int n : {2, 3, 12, 40}) {
+      for (int loops : {0, n / 2, 3 * n}) {
+        for (double kappa : {1.0, 500.0}) {
+          RandomGraphOptions o;
+          o.dimension = d;
+          o.num_poses = n;
+          o.num_loop_closures = loops;
+          o.kappa = kappa;
+          o.tau = kappa == 1.0 ? 300.0 : 0.5;
+          o.seed = seed++;
+          family.push_back(o);
+        }
+      }
+    }
+  }
+  return family;
+}
+
+// The test's own two dense references agree (guards the reference itself).
+TEST(DenseReference, DataMatrixSchurComplementMatchesPaperFormula) {
+  for (const RandomGraphOptions& o : SmallGraphFamily()) {
+    const PoseGraph graph = RandomPoseGraph(o, nullptr);
+    EXPECT_LT(RelativeError(DenseQ(graph), DenseQFromPaper(graph)), 1e-11)
+        << "d " << o.dimension << " n " << o.num_poses;
+  }
+}
+
+// The dense data matrix reproduces the objective (12): tr(X M X^T) = F(x).
+TEST(DenseReference, DataMatrixReproducesObjective) {
+  std::mt19937_64 rng(7);
+  for (const RandomGraphOptions& o : SmallGraphFamily()) {
+    const PoseGraph graph = RandomPoseGraph(o, nullptr);
+    const Poses x = test_util::RandomPoses(o.dimension, o.num_poses, 2, &rng);
+    MatrixXd X(o.dimension, o.num_poses * (1 + o.dimension));
+    X << test_util::StackTranslations(x), test_util::StackRotations(x);
+    const double f = EvaluateObjective(graph, x);
+    EXPECT_NEAR((X * test_util::DenseDataMatrix(graph) * X.transpose()).trace(),
+                f, 1e-11 * f);
+  }
+}
+
+// MultiplyQ(Y) = Y Q for random Y of several ranks; Q dense from M.
+TEST(SESyncProblem, MultiplyQMatchesDenseQ) {
+  std::mt19937_64 rng(11);
+  for (const RandomGraphOptions& o : SmallGraphFamily()) {
+    const PoseGraph graph = RandomPoseGraph(o, nullptr);
+    ASSERT_TRUE(ValidatePoseGraph(graph, nullptr));
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok());
+    EXPECT_EQ(problem.dimension(), o.dimension);
+    EXPECT_EQ(problem.num_poses(), o.num_poses);
+    const MatrixXd Q = DenseQ(graph);
+    for (int r : {1, o.dimension, o.dimension + 2}) {
+      const MatrixXd Y = Gaussian(r, o.dimension * o.num_poses, &rng);
+      MatrixXd YQ;
+      problem.MultiplyQ(Y, &YQ);
+      ASSERT_EQ(YQ.rows(), r);
+      ASSERT_EQ(YQ.cols(), Y.cols());
+      // Round-off: a few sparse products and one Cholesky solve with the
+      // translational Laplacian (condition number <= ~1e4 here): 1e-10.
+      EXPECT_LT(RelativeError(YQ, Y * Q), 1e-10)
+          << "d " << o.dimension << " n " << o.num_poses << " loops "
+          << o.num_loop_closures << " r " << r;
+    }
+  }
+}
+
+// The documented sparse pieces: M = [L(W^tau) -V; -V^T D], Lbar and Vbar drop
+// pose 0, and L(G^rho) = D - Sigma is Q of the same graph with t~ = 0.
+TEST(SESyncProblem, SparseBlocksMatchDenseDataMatrix) {
+  for (const RandomGraphOptions& o : SmallGraphFamily()) {
+    const PoseGraph graph = RandomPoseGraph(o, nullptr);
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok());
+    const int d = o.dimension, n = o.num_poses;
+    const MatrixXd M = test_util::DenseDataMatrix(graph);
+    const double scale = M.norm();
+    EXPECT_LT(
+        (MatrixXd(problem.D()) - M.bottomRightCorner(d * n, d * n)).norm(),
+        1e-13 * scale);
+    EXPECT_LT((MatrixXd(problem.Vbar()) + M.block(1, n, n - 1, d * n)).norm(),
+              1e-13 * scale);
+    const MatrixXd Lbar =
+        MatrixXd(problem.Lbar()).selfadjointView<Eigen::Lower>();
+    EXPECT_LT((Lbar - M.block(1, 1, n - 1, n - 1)).norm(), 1e-13 * scale);
+    PoseGraph rotation_only = graph;
+    for (auto& e : rotation_only.measurements) e.t.setZero();
+    EXPECT_LT(RelativeError(MatrixXd(problem.RotationLaplacian()),
+                            DenseQ(rotation_only)),
+              1e-12);
+  }
+}
+
+// Rotations -> F(Y) with Y = R equals F(x) at the optimal translations, which
+// are pose 0 at the origin and are a stationary point (and minimum) in t.
+TEST(SESyncProblem, RecoverTranslationsIsOptimalAndReproducesObjective) {
+  std::mt19937_64 rng(13);
+  for (const RandomGraphOptions& o : SmallGraphFamily()) {
+    Poses truth;
+    const PoseGraph graph = RandomPoseGraph(o, &truth);
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok());
+    const int d = o.dimension, n = o.num_poses;
+    std::vector<MatrixXd> rotation_sets = {
+        test_util::StackRotations(truth),
+        test_util::StackRotations(test_util::RandomPoses(d, n, 1, &rng))};
+    for (const MatrixXd& R : rotation_sets) {
+      const MatrixXd T = problem.RecoverTranslations(R);
+      ASSERT_EQ(T.rows(), d);
+      ASSERT_EQ(T.cols(), n);
+      EXPECT_EQ(T.col(0).norm(), 0.0) << "documented gauge t_0 = 0";
+      const Poses x = test_util::PosesFromMatrices(R, T);
+      const double f = EvaluateObjective(graph, x);
+      MatrixXd RQ;
+      problem.MultiplyQ(R, &RQ);
+      const double f_rotations = Inner(R, RQ);
+      // Both are sums of m nonnegative terms of size ~f: 1e-10 relative.
+      EXPECT_NEAR(f_rotations, f, 1e-10 * std::max(f, 1e-12))
+          << "d " << d << " n " << n;
+      // Stationarity in t: F(T + s P) - F(T - s P) = 4 s <grad_T F, P> = 0,
+      // and minimality: F(T + s P) >= F(T).
+      for (int trial = 0; trial < 5; ++trial) {
+        const MatrixXd P = Gaussian(d, n, &rng);
+        const double s = 0.3;
+        const double f_plus = EvaluateObjective(
+            graph, test_util::PosesFromMatrices(R, T + s * P));
+        const double f_minus = EvaluateObjective(
+            graph, test_util::PosesFromMatrices(R, T - s * P));
+        const double curvature = f_plus + f_minus - 2 * f;
+        EXPECT_GE(f_plus, f - 1e-12 * f);
+        EXPECT_GE(f_minus, f - 1e-12 * f);
+        // The odd part must vanish relative to the even (curvature) part and
+        // the round-off of the sums (~1e-14 (f_plus + f_minus)).
+        EXPECT_LE(std::abs(f_plus - f_minus),
+                  1e-9 * curvature + 1e-12 * (f_plus + f_minus));
+      }
+    }
+  }
+}
+
+TEST(SESyncProblem, BlockDiagonalMultiplyMatchesDense) {
+  std::mt19937_64 rng(17);
+  for (int d : {2, 3}) {
+    const int n = 7, r = 5;
+    const MatrixXd V = Gaussian(r, d * n, &rng);
+    const MatrixXd Lambda = Gaussian(d, d * n, &rng);
+    MatrixXd out;
+    internal::BlockDiagonalMultiply(V, Lambda, d, &out);
+    EXPECT_LT(
+        RelativeError(out, V * test_util::BlockDiagonalToDense(Lambda, d)),
+        1e-15);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// SESyncCost: F(Y) = tr(Q Y^T Y) on St(d, r)^n.
+
+struct CostFixture {
+  explicit CostFixture(const RandomGraphOptions& o,
+                       PreconditionerType type = PreconditionerType::kNone)
+      : graph(RandomPoseGraph(o, nullptr)),
+        problem(graph),
+        preconditioner(problem, type, 1e6),
+        cost(&problem, &preconditioner),
+        Q(DenseQ(graph)) {}
+  PoseGraph graph;
+  SESyncProblem problem;
+  SESyncPreconditioner preconditioner;
+  SESyncCost cost;
+  MatrixXd Q;
+};
+
+MatrixXd RandomTangent(const MatrixXd& Y, int d, std::mt19937_64* rng) {
+  MatrixXd V;
+  ProjectToStiefelProductTangent(Y, Gaussian(Y.rows(), Y.cols(), rng), d, &V);
+  return V;
+}
+
+std::vector<RandomGraphOptions> CostGraphs() {
+  std::vector<RandomGraphOptions> graphs;
+  for (int d : {2, 3}) {
+    RandomGraphOptions o;
+    o.dimension = d;
+    o.num_poses = 25;
+    o.num_loop_closures = 30;
+    o.kappa = 20;
+    o.tau = 10;
+    o.seed = 100 + d;
+    graphs.push_back(o);
+  }
+  return graphs;
+}
+
+TEST(SESyncCost, ValueAndLambdaMatchDense) {
+  std::mt19937_64 rng(19);
+  for (const RandomGraphOptions& o : CostGraphs()) {
+    CostFixture fx(o);
+    const int d = o.dimension;
+    for (int r : {d, d + 1, d + 3}) {
+      const MatrixXd Y = RandomStiefelProductPoint(d, r, o.num_poses, &rng);
+      const double f = fx.cost.Evaluate(Y);
+      const double f_dense = (Y * fx.Q * Y.transpose()).trace();
+      EXPECT_NEAR(f, f_dense, 1e-10 * std::abs(f_dense));
+      // Lambda = SymBlockDiag_d(Q Y^T Y), blockwise sym((Q Y^T Y)_ii).
+      const MatrixXd QYY = fx.Q * Y.transpose() * Y;
+      const MatrixXd& Lambda = fx.cost.Lambda();
+      ASSERT_EQ(Lambda.rows(), d);
+      ASSERT_EQ(Lambda.cols(), d * o.num_poses);
+      for (int i = 0; i < o.num_poses; ++i) {
+        const MatrixXd B = QYY.block(d * i, d * i, d, d);
+        EXPECT_LT(
+            (Lambda.middleCols(d * i, d) - 0.5 * (B + B.transpose())).norm(),
+            1e-10 * fx.Q.norm());
+      }
+    }
+  }
+}
+
+// d/dt F(R_Y(t V)) at t = 0 equals <grad F(Y), V> (central differences).
+TEST(SESyncCost, GradientMatchesFiniteDifferencesAlongRetraction) {
+  std::mt19937_64 rng(23);
+  for (const RandomGraphOptions& o : CostGraphs()) {
+    CostFixture fx(o);
+    const int d = o.dimension;
+    for (int r : {d, d + 2}) {
+      for (int trial = 0; trial < 3; ++trial) {
+        const MatrixXd Y = RandomStiefelProductPoint(d, r, o.num_poses, &rng);
+        fx.cost.Evaluate(Y);
+        MatrixXd g;
+        fx.cost.Gradient(&g);
+        // The gradient is tangent: Y_i^T g_i is skew.
+        MatrixXd pg;
+        ProjectToStiefelProductTangent(Y, g, d, &pg);
+        EXPECT_LT((pg - g).norm(), 1e-12 * g.norm());
+        // ... and is the projection of the Euclidean gradient 2 Y Q.
+        MatrixXd projected;
+        ProjectToStiefelProductTangent(Y, 2 * Y * fx.Q, d, &projected);
+        EXPECT_LT(RelativeError(g, projected), 1e-10);
+        const MatrixXd V = RandomTangent(Y, d, &rng);
+        const double h = 1e-5;
+        MatrixXd Yp, Ym;
+        fx.cost.Retract(Y, h * V, &Yp);
+        fx.cost.Retract(Y, -h * V, &Ym);
+        const double fd =
+            (fx.cost.Evaluate(Yp) - fx.cost.Evaluate(Ym)) / (2 * h);
+        // Truncation O(h^2 |phi'''|) plus round-off ~1e-16 F / h: relative
+        // to ||g|| ||V|| this is < 1e-8; a wrong factor would be O(1).
+        EXPECT_NEAR(fd, Inner(g, V), 1e-7 * g.norm() * V.norm());
+      }
+    }
+  }
+}
+
+// Hess[V] = lim Proj_Y(grad(R_Y(hV)) - grad(R_Y(-hV))) / (2h), and the
+// Hessian is symmetric on the tangent space; at random (non-critical) points
+// and at a point near a critical point.
+TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
+  std::mt19937_64 rng(29);
+  for (const RandomGraphOptions& o : CostGraphs()) {
+    CostFixture fx(o);
+    const int d = o.dimension;
+    for (int r : {d, d + 2}) {
+      for (int trial = 0; trial < 3; ++trial) {
+        const MatrixXd Y = RandomStiefelProductPoint(d, r, o.num_poses, &rng);
+        const MatrixXd V = RandomTangent(Y, d, &rng);
+        const MatrixXd U = RandomTangent(Y, d, &rng);
+        const double h = 1e-5;
+        MatrixXd Yp, Ym, gp, gm;
+        fx.cost.Retract(Y, h * V, &Yp);
+        fx.cost.Retract(Y, -h * V, &Ym);
+        fx.cost.Evaluate(Yp);
+        fx.cost.Gradient(&gp);
+        fx.cost.Evaluate(Ym);
+        fx.cost.Gradient(&gm);
+        MatrixXd fd;
+        ProjectToStiefelProductTangent(Y, (gp - gm) / (2 * h), d, &fd);
+        fx.cost.Evaluate(Y);
+        MatrixXd HV, HU;
+        fx.cost.HessianVector(V, &HV);
+        fx.cost.HessianVector(U, &HU);
+        EXPECT_LT(RelativeError(HV, fd), 1e-6) << "d " << d << " r " << r;
+        // Tangent output.
+        MatrixXd p;
+        ProjectToStiefelProductTangent(Y, HV, d, &p);
+        EXPECT_LT((p - HV).norm(), 1e-12 * HV.norm());
+        // Symmetry.
+        const double uhv = Inner(U, HV), vhu = Inner(V, HU);
+        EXPECT_NEAR(uhv, vhu, 1e-11 * HV.norm() * U.norm());
+      }
+    }
+  }
+}
+
+// The preconditioners: the documented dense operators, and symmetric positive
+// definite on the tangent space (the operator Proj o P o Proj).
+TEST(SESyncPreconditioner, AllTypesAreDocumentedOperatorsAndSpdOnTangent) {
+  std::mt19937_64 rng(31);
+  for (const RandomGraphOptions& o : CostGraphs()) {
+    const int d = o.dimension, n = o.num_poses, dn = d * n;
+    const PoseGraph graph = RandomPoseGraph(o, nullptr);
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok());
+    const MatrixXd Q = DenseQ(graph);
+    const MatrixXd D = MatrixXd(problem.D());
+    // eps = Gershgorin bound on lambda_max(D) / max_condition (documented).
+    const double max_condition = 1e6;
+    const double eps = D.cwiseAbs().rowwise().sum().maxCoeff() / max_condition;
+    const MatrixXd I = MatrixXd::Identity(dn, dn);
+    MatrixXd block_jacobi = MatrixXd::Zero(dn, dn);
+    for (int i = 0; i < n; ++i) {
+      block_jacobi.block(d * i, d * i, d, d) =
+          (D.block(d * i, d * i, d, d) + eps * MatrixXd::Identity(d, d))
+              .inverse();
+    }
+    struct Case {
+      PreconditionerType type;
+      MatrixXd dense_inverse;
+    };
+    const std::vector<Case> cases = {
+        {PreconditionerType::kBlockJacobi, block_jacobi},
+        {PreconditionerType::kSparseCholesky, (D + eps * I).inverse()},
+        {PreconditionerType::kRegularizedQ, (Q + eps * I).inverse()}};
+    for (const Case& c : cases) {
+      SESyncPreconditioner preconditioner(problem, c.type, max_condition);
+      EXPECT_EQ(preconditioner.type(), c.type);
+      const MatrixXd V = Gaussian(4, dn, &rng);
+      MatrixXd X;
+      preconditioner.Apply(V, &X);
+      // Condition number <= 1e6 by construction: 1e-8 relative.
+      EXPECT_LT(RelativeError(X, V * c.dense_inverse), 1e-8)
+          << "type " << static_cast<int>(c.type) << " d " << d;
+
+      // Proj o P o Proj as a dense operator on R^{r x dn} (column-major vec).
+      SESyncCost cost(&problem, &preconditioner);
+      const int r = d + 1;
+      const MatrixXd Y = RandomStiefelProductPoint(d, r, n, &rng);
+      cost.Evaluate(Y);
+      const int N = r * dn;
+      MatrixXd P(N, N), Pi(N, N);
+      for (int k = 0; k < N; ++k) {
+        MatrixXd e = MatrixXd::Zero(r, dn);
+        e.data()[k] = 1;
+        MatrixXd t, pt;
+        cost.ProjectToTangent(e, &t);
+        cost.Precondition(t, &pt);
+        P.col(k) = Eigen::Map<const VectorXd>(pt.data(), N);
+        Pi.col(k) = Eigen::Map<const VectorXd>(t.data(), N);
+      }
+      EXPECT_LT((P - P.transpose()).norm(), 1e-10 * P.norm())
+          << "preconditioner not symmetric on the tangent space";
+      // Orthonormal basis B of the tangent space (eigenvectors of Pi with
+      // eigenvalue 1); B^T P B must be positive definite.
+      Eigen::SelfAdjointEigenSolver<MatrixXd> proj_eig(Pi);
+      const int tangent_dim = StiefelTangentDimension(d, r) * n;
+      const MatrixXd B = proj_eig.eigenvectors().rightCols(tangent_dim);
+      EXPECT_NEAR(proj_eig.eigenvalues()(N - tangent_dim), 1.0, 1e-10);
+      const MatrixXd Pt = B.transpose() * P * B;
+      Eigen::SelfAdjointEigenSolver<MatrixXd> p_eig(0.5 *
+                                                    (Pt + Pt.transpose()));
+      EXPECT_GT(p_eig.eigenvalues()(0), 0.0)
+          << "type " << static_cast<int>(c.type) << " d " << d;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ceres_sesync

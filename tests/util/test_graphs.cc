@@ -1,0 +1,226 @@
+#include "tests/util/test_graphs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "Eigen/Dense"
+#include "ceres_sesync/langevin.h"
+
+namespace ceres_sesync::test_util {
+
+Eigen::MatrixXd RandomRotation(int d, std::mt19937_64* rng) {
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd G(d, d);
+  for (int k = 0; k < d * d; ++k) G.data()[k] = normal(*rng);
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(G);
+  Eigen::MatrixXd Q = qr.householderQ();
+  const Eigen::MatrixXd R = qr.matrixQR().triangularView<Eigen::Upper>();
+  for (int k = 0; k < d; ++k) {
+    if (R(k, k) < 0) Q.col(k) *= -1;
+  }
+  if (Q.determinant() < 0) Q.col(0) *= -1;
+  return Q;
+}
+
+Poses RandomPoses(int d, int n, double translation_scale,
+                  std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> uniform(-translation_scale,
+                                                 translation_scale);
+  Poses poses(n);
+  for (Pose& p : poses) {
+    p.R = RandomRotation(d, rng);
+    p.t.resize(d);
+    for (int a = 0; a < d; ++a) p.t(a) = uniform(*rng);
+  }
+  return poses;
+}
+
+namespace {
+
+RelativePoseMeasurement ExactMeasurement(const Poses& truth, int i, int j,
+                                         double kappa, double tau) {
+  RelativePoseMeasurement e;
+  e.i = i;
+  e.j = j;
+  e.R = truth[i].R.transpose() * truth[j].R;
+  e.t = truth[i].R.transpose() * (truth[j].t - truth[i].t);
+  e.kappa = kappa;
+  e.tau = tau;
+  return e;
+}
+
+}  // namespace
+
+PoseGraph RandomPoseGraph(const RandomGraphOptions& options,
+                          Poses* ground_truth) {
+  const int d = options.dimension, n = options.num_poses;
+  std::mt19937_64 rng(options.seed);
+  const Poses truth = RandomPoses(d, n, options.translation_scale, &rng);
+  PoseGraph graph;
+  graph.dimension = d;
+  for (int k = 0; k < n; ++k) graph.AddVertex(k);
+  std::vector<std::pair<int, int>> edges;
+  for (int k = 1; k < n; ++k) {
+    const int parent = options.chain
+                           ? k - 1
+                           : std::uniform_int_distribution<int>(0, k - 1)(rng);
+    edges.emplace_back(parent, k);
+  }
+  if (n >= 2) {
+    std::uniform_int_distribution<int> pick(0, n - 1);
+    for (int c = 0; c < options.num_loop_closures; ++c) {
+      int i = pick(rng), j = pick(rng);
+      while (j == i) j = pick(rng);
+      edges.emplace_back(i, j);
+    }
+  }
+  std::normal_distribution<double> normal;
+  for (auto [i, j] : edges) {
+    if (std::uniform_int_distribution<int>(0, 1)(rng)) std::swap(i, j);
+    RelativePoseMeasurement e =
+        ExactMeasurement(truth, i, j, options.kappa, options.tau);
+    if (!options.noiseless) {
+      e.R = e.R * SampleIsotropicLangevin(d, options.kappa, &rng);
+      for (int a = 0; a < d; ++a) {
+        e.t(a) += normal(rng) / std::sqrt(options.tau);
+      }
+    }
+    graph.measurements.push_back(e);
+  }
+  if (ground_truth) *ground_truth = truth;
+  return graph;
+}
+
+void MakeMeasurementsExact(const Poses& truth, PoseGraph* graph) {
+  for (RelativePoseMeasurement& e : graph->measurements) {
+    e = ExactMeasurement(truth, e.i, e.j, e.kappa, e.tau);
+  }
+}
+
+Eigen::MatrixXd StackRotations(const Poses& poses) {
+  const int n = static_cast<int>(poses.size());
+  const int d = n > 0 ? static_cast<int>(poses[0].R.rows()) : 0;
+  Eigen::MatrixXd R(d, d * n);
+  for (int i = 0; i < n; ++i) R.middleCols(d * i, d) = poses[i].R;
+  return R;
+}
+
+Eigen::MatrixXd StackTranslations(const Poses& poses) {
+  const int n = static_cast<int>(poses.size());
+  const int d = n > 0 ? static_cast<int>(poses[0].t.size()) : 0;
+  Eigen::MatrixXd T(d, n);
+  for (int i = 0; i < n; ++i) T.col(i) = poses[i].t;
+  return T;
+}
+
+Poses PosesFromMatrices(const Eigen::MatrixXd& R, const Eigen::MatrixXd& T) {
+  const int d = static_cast<int>(R.rows());
+  const int n = static_cast<int>(T.cols());
+  Poses poses(n);
+  for (int i = 0; i < n; ++i) {
+    poses[i].R = R.middleCols(d * i, d);
+    poses[i].t = T.col(i);
+  }
+  return poses;
+}
+
+double GaugeInvariantPoseDistance(const Poses& a, const Poses& b) {
+  if (a.size() != b.size() || a.empty()) return INFINITY;
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Eigen::MatrixXd ra = a[0].R.transpose() * a[i].R;
+    const Eigen::MatrixXd rb = b[0].R.transpose() * b[i].R;
+    const Eigen::VectorXd ta = a[0].R.transpose() * (a[i].t - a[0].t);
+    const Eigen::VectorXd tb = b[0].R.transpose() * (b[i].t - b[0].t);
+    worst = std::max({worst, (ra - rb).norm(), (ta - tb).norm()});
+  }
+  return worst;
+}
+
+Eigen::MatrixXd DenseDataMatrix(const PoseGraph& graph) {
+  const int d = graph.dimension, n = graph.num_poses;
+  const int size = n + d * n;
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(size, size);
+  for (const RelativePoseMeasurement& m : graph.measurements) {
+    // X E = R_j - R_i R~ with X = [T R]: E selects block j, minus block i
+    // times R~.
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(size, d);
+    E.middleRows(n + d * m.j, d) += Eigen::MatrixXd::Identity(d, d);
+    E.middleRows(n + d * m.i, d) -= m.R;
+    M += m.kappa * E * E.transpose();
+    // X e = t_j - t_i - R_i t~.
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
+    e(m.j) += 1;
+    e(m.i) -= 1;
+    e.segment(n + d * m.i, d) -= m.t;
+    M += m.tau * e * e.transpose();
+  }
+  return M;
+}
+
+Eigen::MatrixXd DenseQ(const PoseGraph& graph) {
+  const int d = graph.dimension, n = graph.num_poses;
+  const Eigen::MatrixXd M = DenseDataMatrix(graph);
+  const Eigen::MatrixXd Mtt = M.topLeftCorner(n, n);
+  const Eigen::MatrixXd Mtr = M.topRightCorner(n, d * n);
+  const Eigen::MatrixXd Mrr = M.bottomRightCorner(d * n, d * n);
+  const Eigen::MatrixXd pinv =
+      Mtt.completeOrthogonalDecomposition().pseudoInverse();
+  Eigen::MatrixXd Q = Mrr - Mtr.transpose() * pinv * Mtr;
+  return 0.5 * (Q + Q.transpose());
+}
+
+Eigen::MatrixXd DenseQFromPaper(const PoseGraph& graph) {
+  const int d = graph.dimension, n = graph.num_poses;
+  const int m = static_cast<int>(graph.measurements.size());
+  // Rotational connection Laplacian L(G^rho), eq. (14).
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(d * n, d * n);
+  // Incidence A (n x m), Omega^{1/2}, T (m x dn), eqs. (16)-(19).
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, m);
+  Eigen::MatrixXd sqrt_omega = Eigen::MatrixXd::Zero(m, m);
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, d * n);
+  for (int k = 0; k < m; ++k) {
+    const RelativePoseMeasurement& e = graph.measurements[k];
+    const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(d, d);
+    L.block(d * e.i, d * e.i, d, d) += e.kappa * I;
+    L.block(d * e.j, d * e.j, d, d) += e.kappa * I;
+    L.block(d * e.i, d * e.j, d, d) -= e.kappa * e.R;
+    L.block(d * e.j, d * e.i, d, d) -= e.kappa * e.R.transpose();
+    A(e.i, k) = -1;
+    A(e.j, k) = 1;
+    sqrt_omega(k, k) = std::sqrt(e.tau);
+    T.block(k, d * e.i, 1, d) = -e.t.transpose();
+  }
+  // Pi = I - B^+ B for B = A Omega^{1/2}: the projector onto ker(B).
+  const Eigen::MatrixXd B = A * sqrt_omega;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(B, Eigen::ComputeFullV);
+  const Eigen::VectorXd s = svd.singularValues();
+  const double tol = 1e-10 * s(0);
+  int rank = 0;
+  while (rank < s.size() && s(rank) > tol) ++rank;
+  const Eigen::MatrixXd Vr = svd.matrixV().leftCols(rank);
+  const Eigen::MatrixXd Pi =
+      Eigen::MatrixXd::Identity(m, m) - Vr * Vr.transpose();
+  const Eigen::MatrixXd W = sqrt_omega * T;
+  Eigen::MatrixXd Q = L + W.transpose() * Pi * W;
+  return 0.5 * (Q + Q.transpose());
+}
+
+double DenseMinEigenvalue(const Eigen::MatrixXd& S,
+                          Eigen::VectorXd* eigenvector) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
+  if (eigenvector) *eigenvector = eig.eigenvectors().col(0);
+  return eig.eigenvalues()(0);
+}
+
+Eigen::MatrixXd BlockDiagonalToDense(const Eigen::MatrixXd& Lambda, int d) {
+  const int dn = static_cast<int>(Lambda.cols());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(dn, dn);
+  for (int i = 0; i < dn / d; ++i) {
+    out.block(d * i, d * i, d, d) = Lambda.middleCols(d * i, d);
+  }
+  return out;
+}
+
+}  // namespace ceres_sesync::test_util
