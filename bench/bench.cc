@@ -1,0 +1,573 @@
+// Benchmark: SE-Sync versus Ceres local search on the standard pose-graph
+// datasets (Rosen et al., IJRR 2019, Section 6.2, Tables 1-2).
+//
+//   bench [--quick] [--repeats N] [--out_dir DIR] [--ceres_max_time S]
+//         [--poses_dir DIR] [--sesync_only] [files...]
+//
+// Without files: every .g2o in CERES_SESYNC_DATA_DIR, sorted by name
+// (--quick: tinyGrid3D, smallGrid3D, CSAIL, intel, one repeat).
+//
+// Per dataset, in one process (file reading is never timed):
+//  - SE-Sync (default SolverOptions, chordal initialization); time = the
+//    wall time of Solve(), which includes building the data matrices, the
+//    initialization, the staircase, the certificate and the rounding. The
+//    stage breakdown of the fastest repeat goes to bench_stages.csv.
+//  - Certify() of the SE-Sync solution (time), and of the file's own VERTEX
+//    guess when it has one (expected NOT to certify: lower bound and relative
+//    bound reported).
+//  - Ceres PDL-GN and LM from the chordal initialization (time includes
+//    computing it; chordal_time_s reports it separately) and from the file's
+//    vertices (odometry composition if it has none), each followed by
+//    Certify() of the result.
+// Times are the minimum and median over the repeats (the machine is shared;
+// the minimum is the least disturbed measurement). Runs from the file's
+// initial guess are repeated --odometry_repeats times (default 1): several
+// of them end at the time limit.
+//
+// Output in --out_dir: bench.md (Markdown table + summary), bench.csv,
+// bench_stages.csv. The same Markdown is printed to stdout.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "ceres_sesync/ceres_baseline.h"
+#include "ceres_sesync/certification.h"
+#include "ceres_sesync/chordal_initialization.h"
+#include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/pose_graph.h"
+#include "ceres_sesync/sesync_solver.h"
+#include "gflags/gflags.h"
+#include "glog/logging.h"
+
+DEFINE_bool(quick, false,
+            "Only tinyGrid3D, smallGrid3D, CSAIL and intel, one repeat.");
+DEFINE_int32(repeats, 3, "Timed repeats per method (min and median kept).");
+DEFINE_int32(odometry_repeats, 1,
+             "Repeats of the Ceres runs from the file's initial guess "
+             "(capped by --repeats).");
+DEFINE_string(out_dir, ".",
+              "Directory for bench.md, bench.csv, "
+              "bench_stages.csv.");
+DEFINE_double(ceres_max_time, 60,
+              "Wall-clock limit of each Ceres solve in seconds; runs that "
+              "hit it are marked 'timeout'.");
+DEFINE_string(poses_dir, "",
+              "If set, write the SE-Sync solution and the initial guess of "
+              "each dataset as g2o VERTEX files DATASET_sesync.g2o and "
+              "DATASET_initial.g2o here (for plot_trajectory.py).");
+DEFINE_bool(sesync_only, false,
+            "Run only SE-Sync (for peak-memory measurements with "
+            "/usr/bin/time -v).");
+
+namespace ceres_sesync {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const size_t k = v.size() / 2;
+  return v.size() % 2 ? v[k] : 0.5 * (v[k - 1] + v[k]);
+}
+
+double Min(const std::vector<double>& v) {
+  return v.empty() ? NAN : *std::min_element(v.begin(), v.end());
+}
+
+// Optimal values of Tables 1-2 of the paper, as cited in
+// ../shared/sesync-notes.md (rounded to four digits there).
+const std::map<std::string, double>& PaperOptima() {
+  static const std::map<std::string, double> optima = {
+      {"CSAIL", 3.170e1},      {"intel", 5.235e1},
+      {"manhattan", 6.432e3},  {"city10000", 6.386e2},
+      {"ais2klinik", 1.885e2}, {"sphere2500", 1.687e3},
+      {"torus3D", 2.423e4},    {"parking-garage", 1.263e0},
+      {"cubicle", 7.171e2}};
+  return optima;
+}
+
+// One row of the results table.
+struct Row {
+  std::string dataset;
+  int n = 0, m = 0;
+  std::string method;  // SE-Sync, Certify, PDL-GN, LM.
+  std::string init;    // chordal, vertices, odometry, sesync (for Certify).
+  std::vector<double> times;
+  double chordal_time_s = NAN;  // Part of `times` spent on the chordal init.
+  double objective = NAN;
+  std::string certified;  // yes / no / error / "".
+  double lower_bound = NAN;
+  double rel_subopt_bound = NAN;
+  int iterations = -1;
+  std::string status;    // converged / timeout / max_iterations / ...
+  double speedup = NAN;  // time_min / SE-Sync time_min.
+};
+
+struct Stages {
+  std::string dataset;
+  int n = 0, m = 0, d = 0;
+  SolverSummary summary;
+  double wall_s = 0;
+};
+
+std::string Fmt(const char* format, double v) {
+  if (std::isnan(v)) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), format, v);
+  return buf;
+}
+
+std::string BaseName(const std::string& path) {
+  return std::filesystem::path(path).stem().string();
+}
+
+// Fills the certification columns of `row` from Certify(graph, poses).
+void CertifyInto(const PoseGraph& graph, const Poses& poses, Row* row,
+                 double* time_s = nullptr) {
+  Certificate certificate;
+  std::string error;
+  const auto start = Clock::now();
+  if (!Certify(graph, poses, CertifyOptions(), &certificate, &error)) {
+    row->certified = "error";
+    row->status = "certify error: " + error;
+    LOG(WARNING) << row->dataset << " " << row->method << "/" << row->init
+                 << ": Certify failed: " << error;
+    return;
+  }
+  if (time_s) *time_s = SecondsSince(start);
+  row->certified = certificate.certified ? "yes" : "no";
+  row->lower_bound = certificate.lower_bound;
+  row->rel_subopt_bound = certificate.relative_suboptimality_bound;
+  const double tol = CertifyOptions().max_relative_suboptimality;
+  if (certificate.certified &&
+      !(certificate.relative_suboptimality_bound <= tol * (1 + 1e-9))) {
+    // Certify's contract: certified implies bound <= tol. Flag, don't hide.
+    row->certified = "yes (bound > tolerance!)";
+    LOG(WARNING) << row->dataset << " " << row->method << "/" << row->init
+                 << ": Certify says certified but its relative bound is "
+                 << certificate.relative_suboptimality_bound;
+  }
+}
+
+std::string CeresStatus(const CeresBaselineSummary& s) {
+  const ceres::Solver::Summary& c = s.solver_summary;
+  if (c.termination_type == ceres::CONVERGENCE) return "converged";
+  if (c.termination_type == ceres::NO_CONVERGENCE) {
+    if (c.message.find("time") != std::string::npos) return "timeout";
+    if (c.message.find("iteration") != std::string::npos) {
+      return "max_iterations";
+    }
+    return "no_convergence";
+  }
+  return ceres::TerminationTypeToString(c.termination_type);
+}
+
+// Runs Ceres `repeats` times from `initial` (whose computation took
+// `init_time_s`, added to each time) and certifies the result.
+Row RunCeres(const PoseGraph& graph, const std::string& dataset,
+             CeresBaselineOptions::Method method, const std::string& init,
+             const Poses& initial, double init_time_s, int repeats) {
+  Row row;
+  row.dataset = dataset;
+  row.n = graph.num_poses;
+  row.m = static_cast<int>(graph.measurements.size());
+  row.method =
+      method == CeresBaselineOptions::Method::kPowellDogleg ? "PDL-GN" : "LM";
+  row.init = init;
+  if (init == "chordal") row.chordal_time_s = init_time_s;
+  CeresBaselineOptions options;
+  options.method = method;
+  options.max_solver_time_s = FLAGS_ceres_max_time;
+  Poses result;
+  CeresBaselineSummary summary;
+  for (int r = 0; r < repeats; ++r) {
+    std::string error;
+    const auto start = Clock::now();
+    if (!SolveWithCeres(graph, initial, options, &result, &summary, &error)) {
+      row.status = "error: " + error;
+      LOG(WARNING) << dataset << " " << row.method << "/" << init << ": "
+                   << error;
+      return row;
+    }
+    row.times.push_back(init_time_s + SecondsSince(start));
+  }
+  row.objective = EvaluateObjective(graph, result);
+  row.iterations = summary.iterations;
+  row.status = CeresStatus(summary);
+  CertifyInto(graph, result, &row);
+  std::fprintf(stderr,
+               "  %-6s from %-8s  %8.3f s  F = %.6e  %s  certified=%s\n",
+               row.method.c_str(), init.c_str(), Min(row.times), row.objective,
+               row.status.c_str(), row.certified.c_str());
+  return row;
+}
+
+// Peak resident set size of this process so far (VmHWM), in MiB.
+double PeakRssMiB() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) {
+      std::istringstream s(line.substr(6));
+      double kb = 0;
+      s >> kb;
+      return kb / 1024.0;
+    }
+  }
+  return NAN;
+}
+
+bool BenchDataset(const std::string& path, int repeats, std::vector<Row>* rows,
+                  std::vector<Stages>* stages) {
+  const std::string dataset = BaseName(path);
+  PoseGraph graph;
+  std::string error;
+  if (!ReadG2oFile(path, G2oReadOptions(), &graph, &error)) {
+    std::fprintf(stderr, "bench: %s\n", error.c_str());
+    return false;
+  }
+  const int n = graph.num_poses;
+  const int m = static_cast<int>(graph.measurements.size());
+  std::fprintf(stderr, "%s: d = %d, n = %d, m = %d\n", dataset.c_str(),
+               graph.dimension, n, m);
+
+  // --- SE-Sync.
+  Row sesync;
+  sesync.dataset = dataset;
+  sesync.n = n;
+  sesync.m = m;
+  sesync.method = "SE-Sync";
+  sesync.init = "chordal";
+  Stages stage;
+  stage.dataset = dataset;
+  stage.n = n;
+  stage.m = m;
+  stage.d = graph.dimension;
+  Poses sesync_poses;
+  SolverOptions solver_options;  // Defaults: chordal initialization.
+  for (int r = 0; r < repeats; ++r) {
+    SolverSummary summary;
+    const auto start = Clock::now();
+    sesync_poses = Solve(graph, solver_options, &summary);
+    const double wall = SecondsSince(start);
+    sesync.times.push_back(wall);
+    if (r == 0 || wall < stage.wall_s) {
+      stage.summary = summary;
+      stage.wall_s = wall;
+    }
+  }
+  const SolverSummary& s = stage.summary;
+  if (s.status == SolverSummary::Status::kInvalidInput) {
+    std::fprintf(stderr, "bench: %s: %s\n", path.c_str(), s.message.c_str());
+    return false;
+  }
+  sesync.objective = s.objective;
+  sesync.certified = s.certified() ? "yes" : "no";
+  if (s.certified() &&
+      !(s.relative_suboptimality_bound <=
+        solver_options.certification_max_relative_bound * (1 + 1e-9))) {
+    // The SDP solution is certified, but the rounded poses are not within
+    // the tolerance of its lower bound (the relaxation is not exact).
+    sesync.certified =
+        "SDP only (bound > " +
+        Fmt("%g", solver_options.certification_max_relative_bound) + ")";
+  }
+  sesync.lower_bound = s.lower_bound;
+  sesync.rel_subopt_bound = s.relative_suboptimality_bound;
+  sesync.iterations = s.iterations;
+  sesync.status = s.StatusString() + ", rank " + std::to_string(s.final_rank);
+  sesync.chordal_time_s = s.initialization_time_s;
+  const double sesync_time = Min(sesync.times);
+  std::fprintf(stderr, "  SE-Sync             %8.3f s  F = %.6e  %s\n",
+               sesync_time, s.objective, sesync.status.c_str());
+  auto known = PaperOptima().find(dataset);
+  if (known != PaperOptima().end()) {
+    const double rel = std::abs(s.objective - known->second) / known->second;
+    if (rel > 5e-4) {
+      std::fprintf(stderr,
+                   "WARNING: %s: SE-Sync objective %.6e differs from the "
+                   "paper's %.4e by %.2e relative (> 5e-4)\n",
+                   dataset.c_str(), s.objective, known->second, rel);
+      sesync.status += ", DIFFERS FROM PAPER";
+    }
+  }
+  rows->push_back(sesync);
+  stages->push_back(stage);
+
+  if (!FLAGS_poses_dir.empty()) {
+    std::filesystem::create_directories(FLAGS_poses_dir);
+    const std::string base = FLAGS_poses_dir + "/" + dataset;
+    const Poses initial = graph.initial_poses.empty()
+                              ? OdometryInitialization(graph)
+                              : graph.initial_poses;
+    if (!WriteG2oPoses(base + "_sesync.g2o", graph, sesync_poses, &error) ||
+        !WriteG2oPoses(base + "_initial.g2o", graph, initial, &error)) {
+      std::fprintf(stderr, "bench: %s\n", error.c_str());
+    }
+  }
+
+  // --- Certify the SE-Sync solution.
+  {
+    Row row;
+    row.dataset = dataset;
+    row.n = n;
+    row.m = m;
+    row.method = "Certify";
+    row.init = "sesync";
+    row.objective = s.objective;
+    for (int r = 0; r < repeats; ++r) {
+      double t = NAN;
+      CertifyInto(graph, sesync_poses, &row, &t);
+      if (!std::isnan(t)) row.times.push_back(t);
+    }
+    std::fprintf(stderr, "  Certify(SE-Sync)    %8.3f s  certified=%s\n",
+                 Min(row.times), row.certified.c_str());
+    rows->push_back(row);
+  }
+  if (FLAGS_sesync_only) return true;
+
+  // --- Certify the file's own initial guess.
+  if (!graph.initial_poses.empty()) {
+    Row row;
+    row.dataset = dataset;
+    row.n = n;
+    row.m = m;
+    row.method = "Certify";
+    row.init = "vertices";
+    row.objective = EvaluateObjective(graph, graph.initial_poses);
+    double t = NAN;
+    CertifyInto(graph, graph.initial_poses, &row, &t);
+    if (!std::isnan(t)) row.times.push_back(t);
+    std::fprintf(stderr,
+                 "  Certify(vertices)   %8.3f s  F = %.6e  LB = %.6e  "
+                 "certified=%s\n",
+                 Min(row.times), row.objective, row.lower_bound,
+                 row.certified.c_str());
+    rows->push_back(row);
+  }
+
+  // --- Ceres from the chordal initialization (its time included).
+  Poses chordal;
+  double chordal_time = 0;
+  {
+    std::vector<double> t;
+    for (int r = 0; r < repeats; ++r) {
+      const auto start = Clock::now();
+      if (!ChordalInitialization(graph, &chordal, &error)) {
+        std::fprintf(stderr, "bench: %s: chordal: %s\n", path.c_str(),
+                     error.c_str());
+        return false;
+      }
+      t.push_back(SecondsSince(start));
+    }
+    chordal_time = Min(t);
+  }
+  using Method = CeresBaselineOptions::Method;
+  for (Method method : {Method::kPowellDogleg, Method::kLevenbergMarquardt}) {
+    rows->push_back(RunCeres(graph, dataset, method, "chordal", chordal,
+                             chordal_time, repeats));
+  }
+
+  // --- Ceres from the file's vertices (odometry if there are none).
+  const bool has_vertices = !graph.initial_poses.empty();
+  double odometry_time = 0;
+  const auto start = Clock::now();
+  const Poses initial =
+      has_vertices ? graph.initial_poses : OdometryInitialization(graph);
+  if (!has_vertices) odometry_time = SecondsSince(start);
+  const int odometry_repeats =
+      std::max(1, std::min(repeats, FLAGS_odometry_repeats));
+  for (Method method : {Method::kPowellDogleg, Method::kLevenbergMarquardt}) {
+    rows->push_back(RunCeres(graph, dataset, method,
+                             has_vertices ? "vertices" : "odometry", initial,
+                             odometry_time, odometry_repeats));
+  }
+  std::fprintf(stderr, "  peak RSS of the process so far: %.0f MiB\n",
+               PeakRssMiB());
+  return true;
+}
+
+std::string CsvField(const std::string& s) {
+  if (s.find_first_of(",\"") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += (c == '"') ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+}  // namespace
+}  // namespace ceres_sesync
+
+int main(int argc, char** argv) {
+  using namespace ceres_sesync;
+  gflags::SetUsageMessage(
+      "bench [--quick] [--repeats N] [--out_dir DIR] [files...]\n"
+      "SE-Sync vs Ceres PDL-GN/LM on pose-graph datasets.");
+  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
+  google::InitGoogleLogging(argv[0]);
+  FLAGS_logtostderr = true;
+  if (FLAGS_minloglevel < google::GLOG_WARNING) {
+    FLAGS_minloglevel = google::GLOG_WARNING;
+  }
+
+  std::vector<std::string> files(argv + 1, argv + argc);
+  int repeats = std::max(1, FLAGS_repeats);
+  const std::string data_dir = CERES_SESYNC_DATA_DIR;
+  if (FLAGS_quick) {
+    repeats = 1;
+    if (files.empty()) {
+      for (const char* name : {"tinyGrid3D", "smallGrid3D", "CSAIL", "intel"}) {
+        files.push_back(data_dir + "/" + name + ".g2o");
+      }
+    }
+  }
+  if (files.empty()) {
+    std::error_code ec;
+    for (const auto& entry :
+         std::filesystem::directory_iterator(data_dir, ec)) {
+      if (entry.path().extension() == ".g2o") {
+        files.push_back(entry.path().string());
+      }
+    }
+    if (ec || files.empty()) {
+      std::fprintf(stderr, "bench: no .g2o files in %s%s%s\n", data_dir.c_str(),
+                   ec ? ": " : "", ec ? ec.message().c_str() : "");
+      return 2;
+    }
+    std::sort(files.begin(), files.end());
+  }
+
+  std::vector<Row> rows;
+  std::vector<Stages> stages;
+  int failures = 0;
+  for (const std::string& file : files) {
+    if (!BenchDataset(file, repeats, &rows, &stages)) ++failures;
+  }
+
+  // Speedups relative to SE-Sync of the same dataset.
+  std::map<std::string, double> sesync_time;
+  for (const Row& r : rows) {
+    if (r.method == "SE-Sync") sesync_time[r.dataset] = Min(r.times);
+  }
+  for (Row& r : rows) {
+    if (r.method == "SE-Sync" || r.method == "PDL-GN" || r.method == "LM") {
+      r.speedup = Min(r.times) / sesync_time[r.dataset];
+    }
+  }
+
+  // Summary: PDL-GN (chordal) / SE-Sync.
+  double log_sum = 0;
+  int count = 0, sesync_faster = 0;
+  std::string slower;
+  for (const Row& r : rows) {
+    if (r.method != "PDL-GN" || r.init != "chordal" || std::isnan(r.speedup)) {
+      continue;
+    }
+    log_sum += std::log(r.speedup);
+    ++count;
+    if (r.speedup > 1) {
+      ++sesync_faster;
+    } else {
+      slower += (slower.empty() ? "" : ", ") + r.dataset;
+    }
+  }
+  const double geomean = count ? std::exp(log_sum / count) : NAN;
+
+  std::ostringstream md;
+  md << "| dataset | n | m | method | init | time min [s] | time median [s] "
+        "| chordal [s] | objective | certified | rel. subopt. bound | "
+        "iterations | time / SE-Sync | status |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    md << "| " << r.dataset << " | " << r.n << " | " << r.m << " | " << r.method
+       << " | " << r.init << " | " << Fmt("%.4f", Min(r.times)) << " | "
+       << Fmt("%.4f", Median(r.times)) << " | " << Fmt("%.4f", r.chordal_time_s)
+       << " | " << Fmt("%.6e", r.objective) << " | " << r.certified << " | "
+       << Fmt("%.2e", r.rel_subopt_bound) << " | "
+       << (r.iterations >= 0 ? std::to_string(r.iterations) : "") << " | "
+       << Fmt("%.2f", r.speedup) << " | " << r.status << " |\n";
+  }
+  md << "\nStage breakdown of SE-Sync (fastest repeat), seconds:\n\n"
+        "| dataset | d | n | m | data | init | optimize | verify | round | "
+        "total | rank | iterations | Hv products |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Stages& st : stages) {
+    const SolverSummary& s = st.summary;
+    md << "| " << st.dataset << " | " << st.d << " | " << st.n << " | " << st.m
+       << " | " << Fmt("%.4f", s.data_time_s) << " | "
+       << Fmt("%.4f", s.initialization_time_s) << " | "
+       << Fmt("%.4f", s.optimization_time_s) << " | "
+       << Fmt("%.4f", s.verification_time_s) << " | "
+       << Fmt("%.4f", s.rounding_time_s) << " | " << Fmt("%.4f", s.total_time_s)
+       << " | " << s.final_rank << " | " << s.iterations << " | "
+       << s.hessian_vector_products << " |\n";
+  }
+  if (!FLAGS_sesync_only) {
+    md << "\nGeometric mean of PDL-GN(chordal) / SE-Sync time over " << count
+       << " datasets: " << Fmt("%.2f", geomean) << "; SE-Sync (including its "
+       << "certification) is faster on " << sesync_faster << " of " << count
+       << (slower.empty() ? "" : " (slower on: " + slower + ")") << ".\n";
+  }
+  md << "Repeats: " << repeats << " (runs from the file's initial guess: "
+     << std::max(1, std::min(repeats, FLAGS_odometry_repeats))
+     << "); Ceres time limit " << FLAGS_ceres_max_time
+     << " s. Peak RSS of the whole run: " << Fmt("%.0f", PeakRssMiB())
+     << " MiB.\n";
+  std::fputs(md.str().c_str(), stdout);
+
+  std::error_code ec;
+  std::filesystem::create_directories(FLAGS_out_dir, ec);
+  {
+    std::ofstream out(FLAGS_out_dir + "/bench.md");
+    out << md.str();
+    if (!out) {
+      std::fprintf(stderr, "bench: cannot write %s/bench.md\n",
+                   FLAGS_out_dir.c_str());
+      return 2;
+    }
+  }
+  {
+    std::ofstream out(FLAGS_out_dir + "/bench.csv");
+    out << "dataset,n,m,method,init,time_min_s,time_median_s,chordal_time_s,"
+           "objective,certified,lower_bound,rel_subopt_bound,iterations,"
+           "speedup,status\n";
+    for (const Row& r : rows) {
+      out << r.dataset << "," << r.n << "," << r.m << "," << r.method << ","
+          << r.init << "," << Fmt("%.6g", Min(r.times)) << ","
+          << Fmt("%.6g", Median(r.times)) << ","
+          << Fmt("%.6g", r.chordal_time_s) << "," << Fmt("%.10g", r.objective)
+          << "," << r.certified << "," << Fmt("%.10g", r.lower_bound) << ","
+          << Fmt("%.3e", r.rel_subopt_bound) << ","
+          << (r.iterations >= 0 ? std::to_string(r.iterations) : "") << ","
+          << Fmt("%.4g", r.speedup) << "," << CsvField(r.status) << "\n";
+    }
+  }
+  {
+    std::ofstream out(FLAGS_out_dir + "/bench_stages.csv");
+    out << "dataset,d,n,m,wall_s,data_s,initialization_s,optimization_s,"
+           "verification_s,rounding_s,total_s,rank,iterations,"
+           "hessian_vector_products,status\n";
+    for (const Stages& st : stages) {
+      const SolverSummary& s = st.summary;
+      out << st.dataset << "," << st.d << "," << st.n << "," << st.m << ","
+          << st.wall_s << "," << s.data_time_s << "," << s.initialization_time_s
+          << "," << s.optimization_time_s << "," << s.verification_time_s << ","
+          << s.rounding_time_s << "," << s.total_time_s << "," << s.final_rank
+          << "," << s.iterations << "," << s.hessian_vector_products << ","
+          << CsvField(s.StatusString()) << "\n";
+    }
+  }
+  return failures ? 1 : 0;
+}
