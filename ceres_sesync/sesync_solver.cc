@@ -272,7 +272,23 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
 
   // Round and recover translations.
   t = Clock::now();
-  const Eigen::MatrixXd R = internal::RoundSolution(Y, d);
+  Eigen::MatrixXd R = internal::RoundSolution(Y, d);
+  if (options.refine_rounded_solution) {
+    // Local search on O(d)^n = St(d, d)^n from the rounded rotations (blocks
+    // stay in SO(d) by continuity). A no-op when the relaxation is exact.
+    const double rounded = cost.Evaluate(R);
+    if (rounded > sdp_value * (1 + 1e-12)) {
+      RiemannianTrustRegionSummary refine_summary;
+      rtr.callback = nullptr;
+      rtr.preconditioned_gradient_tolerance =
+          options.relative_preconditioned_gradient_tolerance *
+          std::sqrt(rounded);
+      MinimizeRiemannianTrustRegion(rtr, &cost, &R, &refine_summary);
+      s.iterations += refine_summary.iterations;
+      s.hessian_vector_products += refine_summary.hessian_vector_products;
+      R = internal::ProjectBlocksToRotations(R, d);
+    }
+  }
   const Eigen::MatrixXd T = problem.RecoverTranslations(R);
   Poses poses = ToPosesInGauge(graph, R, T);
   s.rounding_time_s = Seconds(t);
@@ -282,16 +298,23 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
   s.eta = verification.eta;
   s.lambda_min_estimate = verification.lambda_min_estimate;
   s.rounding_gap = (s.objective - sdp_value) / std::max(sdp_value, 1e-300);
-  if (s.certified()) {
-    s.lower_bound = sdp_value - s.eta * d * n;
-    s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
-    s.relative_suboptimality_bound =
-        s.lower_bound > 0 ? s.suboptimality_bound / s.lower_bound
-                          : (s.suboptimality_bound == 0 ? 0 : INFINITY);
-  } else {
-    s.lower_bound = -std::numeric_limits<double>::infinity();
-    s.suboptimality_bound = std::numeric_limits<double>::infinity();
-    s.relative_suboptimality_bound = std::numeric_limits<double>::infinity();
+  // tr(Lambda) - eta d n bounds the optimum whenever S + eta I was proven
+  // PSD, certified or not.
+  s.lower_bound = std::isfinite(s.eta) ? sdp_value - s.eta * d * n
+                                       : -std::numeric_limits<double>::infinity();
+  s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
+  s.relative_suboptimality_bound =
+      s.lower_bound > 0 ? s.suboptimality_bound / s.lower_bound
+                        : (s.suboptimality_bound == 0
+                               ? 0
+                               : std::numeric_limits<double>::infinity());
+  if (s.status == SolverSummary::Status::kCertifiedOptimum &&
+      !(s.relative_suboptimality_bound <=
+            options.certification_max_relative_bound &&
+        s.rounding_gap <= options.certification_max_rounding_gap)) {
+    // Y is optimal for the SDP, but the rounded poses are not provably
+    // optimal: the relaxation is not exact on this problem.
+    s.status = SolverSummary::Status::kRelaxationNotExact;
   }
   s.total_time_s = Seconds(start);
   return poses;
@@ -313,6 +336,8 @@ std::string SolverSummary::StatusString() const {
   switch (status) {
     case Status::kCertifiedOptimum:
       return "CERTIFIED_OPTIMUM";
+    case Status::kRelaxationNotExact:
+      return "RELAXATION_NOT_EXACT";
     case Status::kSaddleNotEscaped:
       return "SADDLE_NOT_ESCAPED";
     case Status::kEigenImprecision:

@@ -82,9 +82,18 @@ struct SolverOptions {
   // tables.
   double certification_target_relative_bound = 1e-9;
   double certification_max_relative_bound = 1e-3;
+  // ... and, separately, when the rounded poses attain the relaxation's value:
+  // (F(x) - F(Y)) / F(Y) <= certification_max_rounding_gap. A larger gap
+  // means the SDP relaxation is not exact (kRelaxationNotExact).
+  double certification_max_rounding_gap = 1e-6;
   // Absolute floor on eta relative to max diag(Q's sparse part) (matters for
   // noiseless data where F(Y) = 0).
   double min_relative_eta = 1e-16;
+
+  // After rounding (Algorithm 2), run the local solver on SO(d)^n from the
+  // rounded rotations. No-op when the relaxation is exact; otherwise it
+  // lowers F(x) (and the suboptimality bound).
+  bool refine_rounded_solution = true;
 
   // Wall-clock limit for the whole solve (<= 0: none).
   double max_time_s = 0;
@@ -99,7 +108,14 @@ struct SolverOptions {
 
 struct SolverSummary {
   enum class Status {
-    kCertifiedOptimum,  // S + eta I proven PD: a global optimum.
+    // S + eta I proven PSD at the final Y and the rounded poses are within
+    // certification_max_relative_bound of the optimum: a global optimum.
+    kCertifiedOptimum,
+    // Y is certified optimal for the SDP relaxation, but the rounded poses
+    // are not provably optimal (F(x) - lower bound exceeds the tolerance):
+    // the relaxation is not exact here. The poses are the rounded (and
+    // refined) solution; lower_bound is valid.
+    kRelaxationNotExact,
     kSaddleNotEscaped,  // Negative curvature found, no descent along it.
     kEigenImprecision,  // The eigensolver found no negative curvature.
     kMaxRankReached,    // Not certified at max_rank.
@@ -128,7 +144,8 @@ struct SolverSummary {
   // F(Y) = tr(Q Y^T Y) at the final factor Y (the SDP relaxation's value
   // there).
   double sdp_value = 0;
-  // Proven lower bound on the optimal value: F(Y) - eta d n.
+  // Proven lower bound on the optimal value: F(Y) - eta d n (-inf if no shift
+  // was proven).
   double lower_bound = 0;
   // (objective - lower_bound) and its ratio to lower_bound.
   double suboptimality_bound = 0;
