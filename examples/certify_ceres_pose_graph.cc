@@ -368,6 +368,10 @@ bool RunScenario(int side, double loop_closure_probability, uint64_t seed) {
   // If the candidate is not certified, also compute the SE-Sync solution
   // (started from the candidate) in certificate.improved_poses.
   certify_options.improve_if_not_certified = true;
+  // "Certified" means: proven within this relative distance of the global
+  // optimum (default 1e-3).
+  std::printf("  (tolerance: relative suboptimality <= %g)\n",
+              certify_options.max_relative_suboptimality);
   ceres_sesync::Certificate certificate;
   bool converted;
   if constexpr (kDim == 3) {
@@ -438,6 +442,8 @@ bool RunScenario(int side, double loop_closure_probability, uint64_t seed) {
   PrintCertificate(second);
   outcome.Expect(second.certified,
                  "the warm-started Ceres result is CERTIFIED");
+  outcome.Expect(second.relative_suboptimality_bound <= 1e-6,
+                 "proven within 1e-6 (relative) of the global optimum");
   outcome.Expect(second.objective < ceres_local_objective,
                  "it is better than the Ceres local minimum");
   std::printf(
