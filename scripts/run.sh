@@ -10,7 +10,7 @@ build=${BUILD_DIR:-$root/build}
 tool="$build/ceres_sesync"
 out="$build/demo"
 mkdir -p "$out"
-"$tool" generate cube --side 10 --seed 1 --output "$out/cube.g2o" \
+"$tool" generate cube --side 10 --seed 0 --output "$out/cube.g2o" \
   --ground_truth "$out/cube_ground_truth.g2o"
 status=0
 "$tool" solve "$out/cube.g2o" --output "$out/cube_sesync.g2o" \
