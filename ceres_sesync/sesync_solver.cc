@@ -7,6 +7,7 @@
 #include <memory>
 #include <random>
 
+#include "ceres_sesync/internal/ceres_local_solver.h"
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/chordal.h"
 #include "ceres_sesync/internal/rounding.h"
@@ -172,7 +173,22 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
     // (cheaply, from the current point) if F dropped below the guess.
     t = Clock::now();
     double f = cost.Evaluate(Y);
-    for (int pass = 0; pass < 3; ++pass) {
+    const bool use_ceres =
+        options.local_solver == SolverOptions::LocalSolver::kCeresLbfgs;
+    if (use_ceres) {
+      internal::CeresLocalSolverSummary ceres_summary;
+      internal::MinimizeWithCeresLbfgs(
+          problem, options.ceres_lbfgs_max_iterations,
+          options.ceres_lbfgs_gradient_tolerance,
+          options.relative_decrease_tolerance,
+          options.max_time_s > 0
+              ? std::max(1e-3, options.max_time_s - Seconds(start))
+              : 0,
+          &Y, &ceres_summary);
+      level.iterations += ceres_summary.iterations;
+      level.termination = ceres_summary.termination;
+    }
+    for (int pass = 0; pass < 3 && !use_ceres; ++pass) {
       const double floor = 1e-14 * scale;
       rtr.preconditioned_gradient_tolerance =
           options.relative_preconditioned_gradient_tolerance *
@@ -300,8 +316,9 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
   s.rounding_gap = (s.objective - sdp_value) / std::max(sdp_value, 1e-300);
   // tr(Lambda) - eta d n bounds the optimum whenever S + eta I was proven
   // PSD, certified or not.
-  s.lower_bound = std::isfinite(s.eta) ? sdp_value - s.eta * d * n
-                                       : -std::numeric_limits<double>::infinity();
+  s.lower_bound = std::isfinite(s.eta)
+                      ? sdp_value - s.eta * d * n
+                      : -std::numeric_limits<double>::infinity();
   s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
   s.relative_suboptimality_bound =
       s.lower_bound > 0 ? s.suboptimality_bound / s.lower_bound

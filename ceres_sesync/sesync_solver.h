@@ -60,6 +60,21 @@ struct SolverOptions {
   Preconditioner preconditioner = Preconditioner::kRegularizedQ;
   double regularized_cholesky_max_condition = 1e6;
 
+  enum class LocalSolver {
+    // The built-in truncated-Newton Riemannian trust region (RTR) with the
+    // exact Hessian. Default: fast and reaches high precision.
+    kTrustRegion,
+    // ceres::GradientProblemSolver (LBFGS) on StiefelProductManifold: Ceres
+    // itself as the staircase's local solver (first order; slower to reach
+    // the precision certification needs).
+    kCeresLbfgs,
+  };
+  LocalSolver local_solver = LocalSolver::kTrustRegion;
+  // kCeresLbfgs: iteration limit per level and Ceres's gradient tolerance
+  // (max-norm of x - Plus(x, -grad)).
+  int ceres_lbfgs_max_iterations = 20000;
+  double ceres_lbfgs_gradient_tolerance = 1e-9;
+
   // Local optimization at each rank (Riemannian trust region): the paper's
   // iteration limits.
   int max_iterations = 1000;

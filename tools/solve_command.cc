@@ -18,6 +18,9 @@ DEFINE_int32(max_rank, 10, "solve: maximum staircase rank.");
 DEFINE_string(preconditioner, "q",
               "solve: truncated-CG preconditioner: q (regularized Q, exact "
               "Schur complement)|cholesky (of Q's sparse part)|jacobi|none.");
+DEFINE_string(local_solver, "rtr",
+              "solve: staircase local solver: rtr (built-in trust region) | "
+              "ceres (ceres::GradientProblemSolver LBFGS).");
 DEFINE_double(max_time, 0, "solve: wall-clock limit in seconds (0: none).");
 DEFINE_double(
     gradient_tolerance,
@@ -59,6 +62,13 @@ int RunSolve(const Args& args) {
   } else {
     std::fprintf(stderr, "ceres_sesync solve: unknown --preconditioner '%s'\n",
                  FLAGS_preconditioner.c_str());
+    return kUsageOrInputError;
+  }
+  if (FLAGS_local_solver == "ceres") {
+    options.local_solver = SolverOptions::LocalSolver::kCeresLbfgs;
+  } else if (FLAGS_local_solver != "rtr") {
+    std::fprintf(stderr, "ceres_sesync solve: unknown --local_solver '%s'\n",
+                 FLAGS_local_solver.c_str());
     return kUsageOrInputError;
   }
   options.seed = FLAGS_seed;
