@@ -9,6 +9,8 @@
 // generates a small synthetic cube (5 x 5 x 5 poses) into a temporary file,
 // so the program runs out of the box (and as a test).
 
+#include <unistd.h>  // getpid
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -18,6 +20,7 @@
 
 int main(int argc, char** argv) {
   std::string path;
+  bool remove_input = false;
   if (argc > 1) {
     path = argv[1];
   } else {
@@ -27,8 +30,12 @@ int main(int argc, char** argv) {
     cube.side = 5;
     ceres_sesync::PoseGraph cube_graph;
     std::string error;
-    path = (std::filesystem::temp_directory_path() / "solve_g2o_cube.g2o")
+    // (The process id keeps concurrent runs apart; the file is removed after
+    // reading.)
+    path = (std::filesystem::temp_directory_path() /
+            ("solve_g2o_cube_" + std::to_string(getpid()) + ".g2o"))
                .string();
+    remove_input = true;
     if (!ceres_sesync::GenerateCube(cube, &cube_graph, nullptr, &error) ||
         !ceres_sesync::WriteG2oFile(path, cube_graph, {}, &error)) {
       std::fprintf(stderr, "Cannot generate the example cube: %s\n",
@@ -42,8 +49,11 @@ int main(int argc, char** argv) {
   // 1. Read. Errors come back as "PATH:LINE: what is wrong".
   ceres_sesync::PoseGraph graph;
   std::string error;
-  if (!ceres_sesync::ReadG2oFile(path, ceres_sesync::G2oReadOptions(), &graph,
-                                 &error)) {
+  const bool read = ceres_sesync::ReadG2oFile(
+      path, ceres_sesync::G2oReadOptions(), &graph, &error);
+  std::error_code ignored;
+  if (remove_input) std::filesystem::remove(path, ignored);
+  if (!read) {
     std::fprintf(stderr, "Cannot read %s: %s\n", path.c_str(), error.c_str());
     return 1;
   }

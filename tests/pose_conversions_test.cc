@@ -671,5 +671,49 @@ TEST(PoseConversionsTest, ConstraintsRoundTripOnCubes) {
   EXPECT_TRUE(constraints2.empty());
 }
 
+// The documented gauge: with a poses map, SE-Sync's solution keeps the map's
+// first pose (the one Ceres's examples hold constant) at its value, so it can
+// be copied back into the map without moving that pose.
+TEST(PoseConversionsTest, SolutionKeepsTheFirstMapPoseFixed) {
+  CubeOptions options;
+  options.side = 4;
+  options.seed = 5;
+  PoseGraph cube;
+  Poses truth;
+  std::string error;
+  ASSERT_TRUE(GenerateCube(options, &cube, &truth, &error)) << error;
+  VectorOfConstraints3d constraints;
+  ASSERT_TRUE(PoseGraphToCeres3dConstraints(cube, &constraints, &error));
+  // The user's guess: the ground truth moved by a rigid transform, so the
+  // first pose is not the identity.
+  const Eigen::Isometry3d offset =
+      Eigen::Translation3d(1, -2, 3) *
+      Eigen::AngleAxisd(0.8, Eigen::Vector3d(1, 2, 2).normalized());
+  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>
+      transforms;
+  ASSERT_TRUE(PosesToIsometries(truth, &transforms, &error)) << error;
+  for (Eigen::Isometry3d& T : transforms) T = offset * T;
+  MapOfPoses3d map;
+  ASSERT_TRUE(
+      PosesToCeres3dMap(cube, PosesFromIsometries(transforms), &map, &error))
+      << error;
+  PoseGraph graph;
+  ASSERT_TRUE(PoseGraphFromCeres3d(map, constraints, &graph, &error)) << error;
+  SolverSummary summary;
+  const Poses solution = Solve(graph, SolverOptions(), &summary);
+  ASSERT_TRUE(summary.certified()) << summary.FullReport();
+  ASSERT_EQ(static_cast<int>(solution.size()), graph.num_poses);
+  Poses first_in_map;
+  ASSERT_TRUE(PosesFromCeres3dMap(graph, map, &first_in_map, &error));
+  // Rounding-level agreement (the gauge is applied exactly by the solver, up
+  // to the composition of a few rotations).
+  EXPECT_LE(MaxPoseDifference(solution[0], first_in_map[0]), 1e-9);
+  // And the optimum is invariant: same objective as in the cube's own frame.
+  SolverSummary cube_summary;
+  Solve(cube, SolverOptions(), &cube_summary);
+  EXPECT_NEAR(summary.objective, cube_summary.objective,
+              1e-6 * cube_summary.objective);
+}
+
 }  // namespace
 }  // namespace ceres_sesync
