@@ -13,8 +13,10 @@
 // Two interfaces are provided:
 //
 //  1. Free functions on whole r x (d n) matrices. They are the hot path of the
-//     Riemannian solver: O(n r d^2) work, no heap allocation per block (d = 2
-//     and d = 3 use fixed-size kernels; other d use a dynamic fallback).
+//     Riemannian solver: O(n r d^2) work. d = 2 and d = 3 use fixed-size
+//     kernels with O(1) heap allocations per call (none per block); other d
+//     use a dynamic fallback whose retraction/projection allocate small d x d
+//     eigensolver buffers per block.
 //
 //  2. ceres::Manifold implementations (StiefelManifold, StiefelProductManifold)
 //     so that St(d, r) and St(d, r)^n can be used as parameter-block manifolds
