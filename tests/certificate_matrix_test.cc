@@ -1,0 +1,315 @@
+// Independent tests of the sparse certificate test (internal/
+// certificate_matrix.h) and of VerifyCertificate (internal/verification.h)
+// against a DENSE eigendecomposition of S = Q - Lambda, with Q built densely
+// from first principles in the test (tests/util/test_graphs.h).
+//
+// Multipliers come from (a) the SE-Sync optimum of the graph (Lambda =
+// SymBlockDiag(Q R^T R) at the solver's rotations), (b) a perturbation of it
+// (every rotation turned by a random angle), and (c) a random point of
+// St(d, d + 2)^n. The central property is SOUNDNESS: a successful
+// factorization must never happen when S + cI is clearly indefinite, and a
+// certified result must really have lambda_min(S) >= -eta.
+
+#include "ceres_sesync/internal/certificate_matrix.h"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "Eigen/Dense"
+#include "ceres_sesync/internal/sesync_cost.h"
+#include "ceres_sesync/internal/sesync_problem.h"
+#include "ceres_sesync/internal/verification.h"
+#include "ceres_sesync/sesync_solver.h"
+#include "ceres_sesync/stiefel_manifold.h"
+#include "gtest/gtest.h"
+#include "tests/util/test_graphs.h"
+
+namespace ceres_sesync {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using internal::CertificateMatrix;
+using internal::PreconditionerType;
+using internal::SESyncCost;
+using internal::SESyncPreconditioner;
+using internal::SESyncProblem;
+using internal::VerificationResult;
+using test_util::RandomGraphOptions;
+
+struct Instance {
+  std::string name;
+  int d = 0, n = 0;
+  MatrixXd Lambda;  // d x dn.
+  MatrixXd S;       // Dense Q - Lambda.
+  double lambda_min = 0;
+  double scale = 0;  // ||S||_2.
+  double f = 0;      // F at the point Lambda came from.
+};
+
+class CertificateTest : public ::testing::Test {
+ protected:
+  // Builds the three kinds of multipliers for one random graph.
+  void Build(const RandomGraphOptions& o) {
+    graph_ = test_util::RandomPoseGraph(o, nullptr);
+    problem_ = std::make_unique<SESyncProblem>(graph_);
+    ASSERT_TRUE(problem_->ok());
+    Q_ = test_util::DenseQ(graph_);
+    const int d = o.dimension, n = o.num_poses;
+    SESyncPreconditioner none(*problem_, PreconditionerType::kNone, 1e6);
+    SESyncCost cost(problem_.get(), &none);
+    auto add = [&](const std::string& name, const MatrixXd& Y) {
+      Instance in;
+      in.name = name;
+      in.d = d;
+      in.n = n;
+      in.f = cost.Evaluate(Y);
+      in.Lambda = cost.Lambda();
+      in.S = Q_ - test_util::BlockDiagonalToDense(in.Lambda, d);
+      Eigen::SelfAdjointEigenSolver<MatrixXd> eig(in.S);
+      in.lambda_min = eig.eigenvalues()(0);
+      in.scale = eig.eigenvalues().cwiseAbs().maxCoeff();
+      instances_.push_back(in);
+    };
+    SolverSummary summary;
+    const Poses x = Solve(graph_, SolverOptions(), &summary);
+    ASSERT_TRUE(summary.certified()) << summary.FullReport();
+    const MatrixXd R = test_util::StackRotations(x);
+    add("optimum", R);
+    std::mt19937_64 rng(o.seed + 1000);
+    MatrixXd perturbed = R;
+    std::normal_distribution<double> normal;
+    for (int i = 0; i < n; ++i) {
+      MatrixXd W = MatrixXd::Zero(d, d);
+      for (int a = 0; a < d; ++a) {
+        for (int b = a + 1; b < d; ++b) {
+          W(a, b) = 0.3 * normal(rng);
+          W(b, a) = -W(a, b);
+        }
+      }
+      // Cayley transform of the skew W: a rotation of angle ~|W|.
+      const MatrixXd I = MatrixXd::Identity(d, d);
+      perturbed.middleCols(d * i, d) =
+          R.middleCols(d * i, d) * (I - 0.5 * W).inverse() * (I + 0.5 * W);
+    }
+    add("perturbed", perturbed);
+    add("random", RandomStiefelProductPoint(d, d + 2, n, &rng));
+  }
+
+  PoseGraph graph_;
+  std::unique_ptr<SESyncProblem> problem_;
+  MatrixXd Q_;
+  std::vector<Instance> instances_;
+};
+
+std::vector<RandomGraphOptions> Graphs() {
+  std::vector<RandomGraphOptions> graphs;
+  uint64_t seed = 40;
+  for (int d : {2, 3}) {
+    for (int n : {10, 60}) {
+      RandomGraphOptions o;
+      o.dimension = d;
+      o.num_poses = n;
+      o.num_loop_closures = n;
+      o.kappa = 50;
+      o.tau = 20;
+      o.seed = seed++;
+      graphs.push_back(o);
+    }
+  }
+  // A long chain (poorly conditioned translational Laplacian: the coupling
+  // ||Lbar^{-1} Vbar|| is large) with few loop closures.
+  RandomGraphOptions chain;
+  chain.dimension = 3;
+  chain.num_poses = 150;
+  chain.num_loop_closures = 3;
+  chain.chain = true;
+  chain.kappa = 50;
+  chain.tau = 20;
+  chain.seed = 77;
+  graphs.push_back(chain);
+  return graphs;
+}
+
+// MultiplyCertificate(v) = S v.
+TEST_F(CertificateTest, MultiplyCertificateMatchesDense) {
+  std::mt19937_64 rng(3);
+  for (const RandomGraphOptions& o : Graphs()) {
+    instances_.clear();
+    Build(o);
+    for (const Instance& in : instances_) {
+      VectorXd v(in.d * in.n);
+      std::normal_distribution<double> normal;
+      for (int k = 0; k < v.size(); ++k) v(k) = normal(rng);
+      const VectorXd Sv =
+          internal::MultiplyCertificate(*problem_, in.Lambda, v);
+      EXPECT_LT((Sv - in.S * v).norm(), 1e-10 * in.scale * v.norm()) << in.name;
+    }
+  }
+}
+
+// Factorize(Lambda, c) succeeds iff lambda_min(S) > -c, for shifts whose
+// distance from -lambda_min(S) is far above round-off; and whenever it
+// succeeds, lambda_min(S) >= -proven_shift() (the documented guarantee).
+TEST_F(CertificateTest, FactorizeAgreesWithDenseEigenvalues) {
+  for (const RandomGraphOptions& o : Graphs()) {
+    instances_.clear();
+    Build(o);
+    CertificateMatrix matrix(*problem_);
+    EXPECT_EQ(matrix.dimension(), o.dimension * o.num_poses);
+    for (const Instance& in : instances_) {
+      const double lmin = in.lambda_min, s = in.scale;
+      struct Shift {
+        double c;
+        bool must_succeed;
+      };
+      std::vector<Shift> shifts = {
+          {-lmin + 1e-3 * s, true},   // lambda_min(S + cI) = 1e-3 ||S||.
+          {-lmin - 1e-3 * s, false},  // lambda_min(S + cI) = -1e-3 ||S||.
+          {-lmin + 1e-6 * s, true},
+          {-lmin - 1e-6 * s, false}};
+      if (lmin < -1e-6 * s) {
+        // Straddle -lambda_min by a factor 2 both ways (brief's test); the
+        // "fail" case is lambda_min(S) = -2c: SOUNDNESS.
+        shifts.push_back({-2 * lmin, true});
+        shifts.push_back({-0.5 * lmin, false});
+        shifts.push_back({-1.1 * lmin, true});
+        shifts.push_back({-0.9 * lmin, false});
+      }
+      for (const Shift& sh : shifts) {
+        const bool ok = matrix.Factorize(in.Lambda, sh.c);
+        EXPECT_EQ(ok, sh.must_succeed)
+            << in.name << ": d " << o.dimension << " n " << o.num_poses
+            << " lambda_min(S) " << lmin << " c " << sh.c << " ||S|| " << s;
+        if (ok) {
+          EXPECT_GE(matrix.proven_shift(), sh.c);
+          EXPECT_GE(lmin, -matrix.proven_shift() - 1e-13 * s) << in.name;
+        }
+      }
+    }
+  }
+}
+
+// The soundness test at the resolution the solver works at: S is shifted so
+// that lambda_min(S) = -2c exactly (dense), for c from 1e-6 ||S|| down to
+// 1e-11 ||S|| (the solver's eta is ~1e-9 F / (d n)). A successful
+// factorization of K_c would be a false certificate unless proven_shift()
+// covers the gap.
+TEST_F(CertificateTest, NoFalseCertificateAtSmallShifts) {
+  for (const RandomGraphOptions& o : Graphs()) {
+    instances_.clear();
+    Build(o);
+    CertificateMatrix matrix(*problem_);
+    const Instance& in = instances_[0];  // The optimum: lambda_min ~ 0.
+    const int d = in.d;
+    const double s = in.scale;
+    for (double relative : {1e-6, 1e-8, 1e-9, 1e-10, 1e-11}) {
+      const double c = relative * s;
+      // Lambda' = Lambda + mu I: lambda_min(Q - Lambda') = lambda_min - mu.
+      const double mu = in.lambda_min + 2 * c;
+      MatrixXd shifted = in.Lambda;
+      for (int i = 0; i < in.n; ++i) {
+        shifted.middleCols(d * i, d) += mu * MatrixXd::Identity(d, d);
+      }
+      const bool ok = matrix.Factorize(shifted, c);
+      if (ok) {
+        // Only acceptable if the proven shift accounts for the gap.
+        EXPECT_GE(matrix.proven_shift(), 2 * c * (1 - 1e-6))
+            << "FALSE CERTIFICATE: lambda_min(S) = " << -2 * c
+            << " but K_c factorized with proven_shift " << matrix.proven_shift()
+            << " (c = " << c << ", ||S|| = " << s << ", d " << d << " n "
+            << in.n << ")";
+      }
+    }
+  }
+}
+
+// (S + cI)^{-1} y by the sparse factor equals the dense solve.
+TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
+  std::mt19937_64 rng(5);
+  for (const RandomGraphOptions& o : Graphs()) {
+    instances_.clear();
+    Build(o);
+    CertificateMatrix matrix(*problem_);
+    for (const Instance& in : instances_) {
+      const int dn = in.d * in.n;
+      // lambda_min(S + cI) = 1e-3 ||S||: condition number <= ~1e3.
+      const double c = -in.lambda_min + 1e-3 * in.scale;
+      ASSERT_TRUE(matrix.Factorize(in.Lambda, c));
+      const MatrixXd shifted = in.S + c * MatrixXd::Identity(dn, dn);
+      std::normal_distribution<double> normal;
+      MatrixXd Y(dn, 3);
+      for (int k = 0; k < Y.size(); ++k) Y.data()[k] = normal(rng);
+      const MatrixXd expected = shifted.ldlt().solve(Y);
+      MatrixXd X;
+      matrix.SolveShifted(Y, &X);
+      EXPECT_LT((X - expected).norm(), 1e-9 * expected.norm()) << in.name;
+      VectorXd x;
+      matrix.SolveShifted(VectorXd(Y.col(1)), &x);
+      EXPECT_LT((x - expected.col(1)).norm(), 1e-9 * expected.col(1).norm());
+    }
+  }
+}
+
+// VerifyCertificate against the dense spectrum, with the solver's thresholds
+// (eta ~ 1e-9 F / (d n) target, 1e-6 F / (d n) max) and with a loose eta_max.
+TEST_F(CertificateTest, VerifyCertificateAgreesWithDenseSpectrum) {
+  for (const RandomGraphOptions& o : Graphs()) {
+    instances_.clear();
+    Build(o);
+    CertificateMatrix matrix(*problem_);
+    for (const Instance& in : instances_) {
+      const int dn = in.d * in.n;
+      const double eta_target = 1e-9 * in.f / dn;
+      const double eta_max = 1e-6 * in.f / dn;
+      const VerificationResult v = internal::VerifyCertificate(
+          *problem_, in.Lambda, eta_target, eta_max, &matrix);
+      SCOPED_TRACE(in.name + " d " + std::to_string(in.d) + " n " +
+                   std::to_string(in.n) + " dense lambda_min " +
+                   std::to_string(in.lambda_min));
+      EXPECT_GE(v.factorizations, 1);
+      if (in.name == "optimum") {
+        EXPECT_TRUE(v.certified) << "eta " << v.eta;
+      } else {
+        // Far from optimal: lambda_min(S) is O(1) negative.
+        EXPECT_LT(in.lambda_min, -eta_max);
+        EXPECT_FALSE(v.certified);
+      }
+      // Whatever the outcome, the proven shift must be sound.
+      if (std::isfinite(v.eta)) {
+        EXPECT_GE(in.lambda_min, -v.eta * (1 + 1e-9) - 1e-13 * in.scale)
+            << "eta " << v.eta;
+      }
+      if (v.certified) {
+        EXPECT_LE(v.eta, eta_max);
+      } else {
+        EXPECT_FALSE(v.eigensolver_failed);
+        ASSERT_EQ(v.direction.size(), dn);
+        EXPECT_NEAR(v.direction.norm(), 1.0, 1e-10);
+        const double curvature = v.direction.dot(in.S * v.direction);
+        EXPECT_LT(curvature, 0.0);
+        EXPECT_NEAR(v.direction_curvature, curvature, 1e-9 * in.scale);
+        // Lanczos on (S + cI)^{-1} with tolerance 1e-8, c within 16x of
+        // -lambda_min: 1e-6 relative.
+        EXPECT_NEAR(v.lambda_min_estimate, in.lambda_min,
+                    1e-6 * std::abs(in.lambda_min));
+      }
+
+      // With a generous eta_max every instance is certified with a sound
+      // eta in [-lambda_min, eta_max].
+      const double generous = 4 * std::abs(in.lambda_min) + 1e-6 * in.scale;
+      const VerificationResult w = internal::VerifyCertificate(
+          *problem_, in.Lambda, eta_target, generous, &matrix);
+      EXPECT_TRUE(w.certified);
+      EXPECT_LE(w.eta, generous);
+      EXPECT_GE(in.lambda_min, -w.eta * (1 + 1e-9) - 1e-13 * in.scale);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ceres_sesync
