@@ -159,16 +159,18 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
       const double eps = 1e-14 * std::max(1.0, std::abs(f));
       const double rho =
           (actual_decrease + eps) / (std::max(model_decrease, 0.0) + eps);
-      if (rho < 0.25) {
-        radius *= 0.25;
+      const double step_norm = std::sqrt(Inner(step.eta, step.eta));
+      // Accept only finite decreases that stand above the round-off in f.
+      const double noise =
+          4 * std::numeric_limits<double>::epsilon() * std::abs(f);
+      const bool accepted =
+          rho > 0.1 && std::isfinite(f_new) && f - f_new > noise;
+      if (!accepted || !(rho >= 0.25)) {
+        radius *= 0.25;  // Every rejection shrinks the region (also NaN rho).
       } else if (rho > 0.75 && step.hit_boundary) {
         radius *= 2;
       }
-      const double step_norm = std::sqrt(Inner(step.eta, step.eta));
-      // Accept only decreases that stand above the round-off in f.
-      const double noise =
-          4 * std::numeric_limits<double>::epsilon() * std::abs(f);
-      if (rho > 0.1 && std::isfinite(f_new) && f - f_new > noise) {
+      if (accepted) {
         const double decrease = f - f_new;
         *x = x_new;
         f = f_new;
