@@ -85,15 +85,19 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
       c.negative_curvature = v.direction_curvature;
     }
   }
-  if (!std::isfinite(c.lower_bound)) {
-    c.lower_bound = -std::numeric_limits<double>::infinity();
+  // F is a sum of squares: 0 is always a lower bound, and a candidate at
+  // F = 0 (up to round-off relative to the total weight) is optimal.
+  if (!(c.lower_bound >= 0)) c.lower_bound = 0;
+  double total_weight = 0;
+  for (const RelativePoseMeasurement& e : graph.measurements) {
+    total_weight += e.kappa + e.tau;
   }
+  if (c.objective <= 1e-12 * total_weight) c.certified = true;
   c.suboptimality_bound = c.objective - c.lower_bound;
   c.relative_suboptimality_bound =
       c.lower_bound > 0 ? c.suboptimality_bound / c.lower_bound
-                        : (c.suboptimality_bound <= 0
-                               ? 0
-                               : std::numeric_limits<double>::infinity());
+      : c.certified     ? 0
+                        : std::numeric_limits<double>::infinity();
   c.time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

@@ -81,7 +81,9 @@ struct Certificate {
   // Shift for which S + eta I was proven positive semidefinite (including the
   // factorization's backward-error allowance); +inf if none.
   double eta = 0;
-  // Proven lower bound on the optimal value: tr(Lambda) - eta d n.
+  // Proven lower bound on the optimal value: max(0, tr(Lambda) - eta d n)
+  // (F is a sum of squares). A candidate with F <= 1e-12 * sum(kappa + tau)
+  // (e.g. a tree, or noiseless data) is certified by F >= 0 alone.
   double lower_bound = 0;
   // objective - lower_bound, and that relative to lower_bound.
   double suboptimality_bound = 0;

@@ -1,0 +1,188 @@
+// Soundness tests for Certify(): true optima certify; perturbed optima and
+// Ceres local minima do not, and their lower bounds never exceed the optimum.
+
+#include "ceres_sesync/certification.h"
+
+#include <cmath>
+#include <random>
+
+#include "ceres_sesync/ceres_baseline.h"
+#include "ceres_sesync/cube_generator.h"
+#include "ceres_sesync/sesync_solver.h"
+#include "gtest/gtest.h"
+
+namespace ceres_sesync {
+namespace {
+
+PoseGraph Cube(int d, int side, uint64_t seed) {
+  CubeOptions options;
+  options.dimension = d;
+  options.side = side;
+  options.seed = seed;
+  PoseGraph graph;
+  Poses truth;
+  std::string error;
+  EXPECT_TRUE(GenerateCube(options, &graph, &truth, &error)) << error;
+  return graph;
+}
+
+// Dead reckoning: composes the odometry edges (i, i + 1) in path order.
+Poses DeadReckoning(const PoseGraph& graph) {
+  Poses poses = IdentityPoses(graph.dimension, graph.num_poses);
+  for (const RelativePoseMeasurement& e : graph.measurements) {
+    if (e.j != e.i + 1) continue;
+    poses[e.j].R = poses[e.i].R * e.R;
+    poses[e.j].t = poses[e.i].t + poses[e.i].R * e.t;
+  }
+  return poses;
+}
+
+// Finds a graph whose SE-Sync solution is certified (the relaxation is exact
+// on most small cubes, not all: see the bench cube sweep).
+bool SolveCertified(int d, int side, uint64_t* seed, PoseGraph* graph,
+                    Poses* optimum, SolverSummary* summary) {
+  for (; *seed < 20; ++*seed) {
+    *graph = Cube(d, side, *seed);
+    *optimum = Solve(*graph, SolverOptions(), summary);
+    if (summary->certified()) return true;
+  }
+  return false;
+}
+
+TEST(CertificationTest, OptimumCertifiesAndBoundsAreConsistent) {
+  for (int d : {2, 3}) {
+    uint64_t seed = 0;
+    PoseGraph graph;
+    Poses optimum;
+    SolverSummary summary;
+    ASSERT_TRUE(
+        SolveCertified(d, d == 2 ? 8 : 4, &seed, &graph, &optimum, &summary));
+    Certificate certificate;
+    std::string error;
+    ASSERT_TRUE(Certify(graph, optimum, {}, &certificate, &error)) << error;
+    EXPECT_TRUE(certificate.certified) << certificate.FullReport();
+    EXPECT_NEAR(certificate.objective, summary.objective,
+                1e-12 * summary.objective);
+    EXPECT_LE(certificate.lower_bound, certificate.objective);
+    EXPECT_LE(certificate.relative_suboptimality_bound, 1e-3);
+    EXPECT_EQ(certificate.negative_curvature_direction.size(), 0);
+  }
+}
+
+TEST(CertificationTest, PerturbedOptimumIsNotCertified) {
+  for (int d : {2, 3}) {
+    uint64_t seed = 0;
+    PoseGraph graph;
+    Poses optimum;
+    SolverSummary summary;
+    ASSERT_TRUE(
+        SolveCertified(d, d == 2 ? 8 : 4, &seed, &graph, &optimum, &summary));
+    // Flip a quarter of the poses by a large rotation: a far-off candidate.
+    Poses candidate = optimum;
+    std::mt19937_64 rng(7);
+    for (int i = 0; i < graph.num_poses; i += 4) {
+      Eigen::MatrixXd flip = Eigen::MatrixXd::Identity(d, d);
+      flip(0, 0) = flip(1, 1) = -1;  // Rotation by pi about the last axis.
+      candidate[i].R = candidate[i].R * flip;
+    }
+    Certificate certificate;
+    std::string error;
+    ASSERT_TRUE(Certify(graph, candidate, {}, &certificate, &error)) << error;
+    EXPECT_FALSE(certificate.certified);
+    EXPECT_GT(certificate.objective, summary.objective);
+    // Soundness: the lower bound never exceeds the (certified) optimum.
+    EXPECT_LE(certificate.lower_bound, summary.objective * (1 + 1e-9));
+    ASSERT_EQ(certificate.negative_curvature_direction.size(),
+              d * graph.num_poses);
+    EXPECT_LT(certificate.negative_curvature, 0);
+  }
+}
+
+TEST(CertificationTest, CeresLocalMinimaAreNeverCertified) {
+  int local_minima = 0;
+  // 8^3 cubes at the paper's noise: LM from dead reckoning stalls on some.
+  for (uint64_t seed = 2; seed < 5; ++seed) {
+    const PoseGraph graph = Cube(3, 8, seed);
+    SolverSummary summary;
+    const Poses optimum = Solve(graph, SolverOptions(), &summary);
+    if (!summary.certified()) continue;
+    CeresBaselineOptions options;
+    options.method = CeresBaselineOptions::Method::kLevenbergMarquardt;
+    Poses result;
+    CeresBaselineSummary ceres_summary;
+    std::string error;
+    ASSERT_TRUE(SolveWithCeres(graph, DeadReckoning(graph), options, &result,
+                               &ceres_summary, &error))
+        << error;
+    Certificate certificate;
+    ASSERT_TRUE(Certify(graph, result, {}, &certificate, &error)) << error;
+    EXPECT_LE(certificate.lower_bound, summary.objective * (1 + 1e-9));
+    if (certificate.certified) {
+      // Then Ceres found the optimum, to within the claimed bound.
+      EXPECT_LE(certificate.objective,
+                summary.objective *
+                    (1 + certificate.relative_suboptimality_bound) *
+                    (1 + 1e-12));
+    }
+    if (ceres_summary.final_objective > 1.01 * summary.objective) {
+      ++local_minima;
+      EXPECT_FALSE(certificate.certified) << certificate.FullReport();
+    }
+  }
+  // The test is only meaningful if Ceres stalled somewhere.
+  EXPECT_GT(local_minima, 0);
+}
+
+TEST(CertificationTest, ImproveReturnsTheCertifiedSolution) {
+  uint64_t seed = 0;
+  PoseGraph graph;
+  Poses optimum;
+  SolverSummary summary;
+  ASSERT_TRUE(SolveCertified(3, 4, &seed, &graph, &optimum, &summary));
+  CertifyOptions options;
+  options.improve_if_not_certified = true;
+  Certificate certificate;
+  std::string error;
+  ASSERT_TRUE(
+      Certify(graph, DeadReckoning(graph), options, &certificate, &error));
+  ASSERT_FALSE(certificate.certified);
+  ASSERT_TRUE(certificate.has_improved_poses);
+  EXPECT_TRUE(certificate.improvement_summary.certified());
+  EXPECT_NEAR(EvaluateObjective(graph, certificate.improved_poses),
+              summary.objective, 1e-8 * summary.objective);
+}
+
+TEST(CertificationTest, TreeAndTwoPosesCertifyTrivially) {
+  PoseGraph graph = Cube(3, 3, 0);
+  // Keep only the odometry chain: a tree, fit exactly (F = 0).
+  std::vector<RelativePoseMeasurement> chain;
+  for (const auto& e : graph.measurements) {
+    if (e.j == e.i + 1) chain.push_back(e);
+  }
+  graph.measurements = chain;
+  Certificate certificate;
+  std::string error;
+  ASSERT_TRUE(Certify(graph, DeadReckoning(graph), {}, &certificate, &error))
+      << error;
+  EXPECT_TRUE(certificate.certified) << certificate.FullReport();
+  EXPECT_NEAR(certificate.objective, 0, 1e-9);
+  EXPECT_LE(certificate.lower_bound, 1e-9);
+}
+
+TEST(CertificationTest, RejectsMismatchedCandidates) {
+  const PoseGraph graph = Cube(2, 3, 0);
+  Certificate certificate;
+  std::string error;
+  Poses too_few = IdentityPoses(2, graph.num_poses - 1);
+  EXPECT_FALSE(Certify(graph, too_few, {}, &certificate, &error));
+  EXPECT_NE(error.find("poses"), std::string::npos);
+  Poses wrong_dimension = IdentityPoses(3, graph.num_poses);
+  EXPECT_FALSE(Certify(graph, wrong_dimension, {}, &certificate, &error));
+  Poses nan = IdentityPoses(2, graph.num_poses);
+  nan[1].t(0) = std::nan("");
+  EXPECT_FALSE(Certify(graph, nan, {}, &certificate, &error));
+  EXPECT_NE(error.find("finite"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ceres_sesync
