@@ -115,6 +115,13 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
       options.regularized_cholesky_max_condition);
   internal::CertificateMatrix certificate(problem);
   const double scale = MaxDiagonal(problem.D());
+  // Objective values below this are zero up to round-off (F is a sum of
+  // squares weighted by kappa and tau).
+  double total_weight = 0;
+  for (const RelativePoseMeasurement& e : graph.measurements) {
+    total_weight += e.kappa + e.tau;
+  }
+  const double zero_objective = 1e-12 * total_weight;
   s.data_time_s = Seconds(t);
 
   // Initialization.
@@ -228,6 +235,11 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
                                 sdp_value / (d * n));
     verification = internal::VerifyCertificate(
         problem, cost.Lambda(), eta_target, eta_max, &certificate);
+    if (!verification.certified && sdp_value <= zero_objective) {
+      // F >= 0 always: a (numerically) zero value is optimal as it stands.
+      verification.certified = true;
+      verification.eta = 0;
+    }
     level.verify_time_s = Seconds(t);
     level.certified = verification.certified;
     level.eta = verification.eta;
@@ -317,18 +329,18 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
   // tr(Lambda) - eta d n bounds the optimum whenever S + eta I was proven
   // PSD, certified or not.
   s.lower_bound = std::isfinite(s.eta)
-                      ? sdp_value - s.eta * d * n
-                      : -std::numeric_limits<double>::infinity();
+                      ? std::max(0.0, sdp_value - s.eta * d * n)
+                      : 0.0;  // F >= 0 always.
   s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
   s.relative_suboptimality_bound =
-      s.lower_bound > 0 ? s.suboptimality_bound / s.lower_bound
-                        : (s.suboptimality_bound == 0
-                               ? 0
-                               : std::numeric_limits<double>::infinity());
+      s.lower_bound > 0               ? s.suboptimality_bound / s.lower_bound
+      : s.objective <= zero_objective ? 0
+                                      : std::numeric_limits<double>::infinity();
   if (s.status == SolverSummary::Status::kCertifiedOptimum &&
       !(s.relative_suboptimality_bound <=
             options.certification_max_relative_bound &&
-        s.rounding_gap <= options.certification_max_rounding_gap)) {
+        (s.rounding_gap <= options.certification_max_rounding_gap ||
+         s.objective <= zero_objective))) {
     // Y is optimal for the SDP, but the rounded poses are not provably
     // optimal: the relaxation is not exact on this problem.
     s.status = SolverSummary::Status::kRelaxationNotExact;

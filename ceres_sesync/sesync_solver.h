@@ -159,8 +159,9 @@ struct SolverSummary {
   // F(Y) = tr(Q Y^T Y) at the final factor Y (the SDP relaxation's value
   // there).
   double sdp_value = 0;
-  // Proven lower bound on the optimal value: F(Y) - eta d n (-inf if no shift
-  // was proven).
+  // Proven lower bound on the optimal value: max(0, F(Y) - eta d n) (F is a
+  // sum of squares, so 0 is always one). Poses with F(x) <= 1e-12 sum(kappa +
+  // tau) (trees, noiseless data) are certified by F >= 0 alone.
   double lower_bound = 0;
   // (objective - lower_bound) and its ratio to lower_bound.
   double suboptimality_bound = 0;

@@ -66,7 +66,7 @@ constexpr double kRoundOff = 1e-10;
 // suboptimality bound (F - LB) / LB is then +inf. The absolute bound is tiny,
 // so these optima should be certified. The tests assert the CURRENT behaviour
 // through this flag; flip it to true once zero optima are certified.
-constexpr bool kZeroOptimumIsCertified = false;
+constexpr bool kZeroOptimumIsCertified = true;
 
 Eigen::MatrixXd Rotation(int d, double angle, const Eigen::Vector3d& axis) {
   if (d == 2) return Eigen::Rotation2Dd(angle).toRotationMatrix();
