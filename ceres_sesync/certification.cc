@@ -88,6 +88,7 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
   // F is a sum of squares: 0 is always a lower bound, and a candidate at
   // F = 0 (up to round-off relative to the total weight) is optimal.
   if (!(c.lower_bound >= 0)) c.lower_bound = 0;
+  c.lower_bound = std::min(c.lower_bound, c.objective);
   double total_weight = 0;
   for (const RelativePoseMeasurement& e : graph.measurements) {
     total_weight += e.kappa + e.tau;

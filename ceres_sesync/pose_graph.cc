@@ -87,6 +87,9 @@ bool ValidatePoseGraph(const PoseGraph& graph, std::string* error) {
       return fail(where.str() + "kappa and tau must be finite and positive");
     }
   }
+  if (graph.fixed_pose < -1 || graph.fixed_pose >= graph.num_poses) {
+    return fail("fixed_pose is not a pose index (or -1)");
+  }
   if (!graph.initial_poses.empty()) {
     if (static_cast<int>(graph.initial_poses.size()) != graph.num_poses) {
       return fail("initial_poses must be empty or have one pose per vertex");

@@ -70,7 +70,8 @@ int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component);
 // Checks the structural and numerical invariants every solver relies on:
 // d in {2, 3}; indices in range; no self-loops; finite, positive kappa and
 // tau; rotations in SO(d) to 1e-6; a connected measurement graph; initial
-// poses (if any) of the right size. Returns false with a message otherwise.
+// poses (if any) of the right size; fixed_pose -1 or a pose index. Returns
+// false with a message otherwise.
 bool ValidatePoseGraph(const PoseGraph& graph, std::string* error);
 
 // Evaluates the maximum-likelihood objective F(x) of eq. (12).

@@ -331,6 +331,8 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
   s.lower_bound = std::isfinite(s.eta)
                       ? std::max(0.0, sdp_value - s.eta * d * n)
                       : 0.0;  // F >= 0 always.
+  // The attained objective bounds the optimum too (guards F(Y) round-off).
+  s.lower_bound = std::min(s.lower_bound, s.objective);
   s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
   s.relative_suboptimality_bound =
       s.lower_bound > 0               ? s.suboptimality_bound / s.lower_bound
