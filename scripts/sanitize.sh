@@ -35,10 +35,14 @@ fi
 if [ -s "$supp/ubsan.supp" ]; then
   UBSAN_OPTIONS="$UBSAN_OPTIONS:suppressions=$supp/ubsan.supp"
 fi
-# The consumer_project test configures and links a fresh project against the
+# The consumer_project test configures and builds a fresh project against the
 # installed (instrumented) static library: it needs the sanitizer runtimes at
-# link time. CMake initializes CMAKE_EXE_LINKER_FLAGS from LDFLAGS.
+# link time, and its own code must be instrumented the same way (an
+# uninstrumented consumer freeing Eigen memory allocated in the instrumented
+# library is reported as a bad free). CMake initializes CMAKE_CXX_FLAGS and
+# CMAKE_EXE_LINKER_FLAGS from CXXFLAGS and LDFLAGS.
 export LDFLAGS="-fsanitize=address,undefined"
+export CXXFLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer"
 
 exclude=${CTEST_EXCLUDE-}
 cd "$build"
