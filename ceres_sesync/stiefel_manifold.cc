@@ -772,26 +772,41 @@ bool StiefelProductManifold::Plus(const double* x, const double* delta,
   return AllFinite(x_plus_delta, AmbientSize());
 }
 
-bool StiefelProductManifold::PlusJacobian(const double* x,
-                                          double* jacobian) const {
-  if (!IsValid()) return false;
-  const int ambient = block_.AmbientSize();
-  const int tangent = block_.TangentSize();
-  const std::ptrdiff_t total_tangent = TangentSize();
-  std::fill_n(jacobian,
-              static_cast<std::ptrdiff_t>(AmbientSize()) * total_tangent, 0.0);
-  BlockOps ops(d(), r());
-  for (int i = 0; i < n_; ++i) {
+namespace {
+
+// The block-diagonal orthonormal tangent basis of St(d, r)^n at x, written
+// row-major as the PlusJacobian (ambient x tangent) or, transposed, as the
+// MinusJacobian (tangent x ambient).
+bool WriteProductBasis(int d, int r, int n, const double* x, bool transposed,
+                       double* jacobian) {
+  BlockOps ops(d, r);
+  const int ambient = r * d;
+  const int tangent = StiefelTangentDimension(d, r);
+  const std::ptrdiff_t total_ambient = static_cast<std::ptrdiff_t>(n) * ambient;
+  const std::ptrdiff_t total_tangent = static_cast<std::ptrdiff_t>(n) * tangent;
+  std::fill_n(jacobian, total_ambient * total_tangent, 0.0);
+  for (int i = 0; i < n; ++i) {
     if (!ops.SetPoint(x + static_cast<std::ptrdiff_t>(i) * ambient)) {
       return false;
     }
     const std::ptrdiff_t row0 = static_cast<std::ptrdiff_t>(i) * ambient;
     const std::ptrdiff_t col0 = static_cast<std::ptrdiff_t>(i) * tangent;
     ops.Basis([&](int row, int col, double value) {
-      jacobian[(row0 + row) * total_tangent + col0 + col] = value;
+      if (transposed) {
+        jacobian[(col0 + col) * total_ambient + row0 + row] = value;
+      } else {
+        jacobian[(row0 + row) * total_tangent + col0 + col] = value;
+      }
     });
   }
   return true;
+}
+
+}  // namespace
+
+bool StiefelProductManifold::PlusJacobian(const double* x,
+                                          double* jacobian) const {
+  return IsValid() && WriteProductBasis(d(), r(), n_, x, false, jacobian);
 }
 
 bool StiefelProductManifold::RightMultiplyByPlusJacobian(
@@ -836,24 +851,7 @@ bool StiefelProductManifold::Minus(const double* y, const double* x,
 
 bool StiefelProductManifold::MinusJacobian(const double* x,
                                            double* jacobian) const {
-  if (!IsValid()) return false;
-  const int ambient = block_.AmbientSize();
-  const int tangent = block_.TangentSize();
-  const std::ptrdiff_t total_ambient = AmbientSize();
-  std::fill_n(jacobian,
-              static_cast<std::ptrdiff_t>(TangentSize()) * total_ambient, 0.0);
-  BlockOps ops(d(), r());
-  for (int i = 0; i < n_; ++i) {
-    if (!ops.SetPoint(x + static_cast<std::ptrdiff_t>(i) * ambient)) {
-      return false;
-    }
-    const std::ptrdiff_t row0 = static_cast<std::ptrdiff_t>(i) * ambient;
-    const std::ptrdiff_t col0 = static_cast<std::ptrdiff_t>(i) * tangent;
-    ops.Basis([&](int row, int col, double value) {
-      jacobian[(col0 + col) * total_ambient + row0 + row] = value;
-    });
-  }
-  return true;
+  return IsValid() && WriteProductBasis(d(), r(), n_, x, true, jacobian);
 }
 
 }  // namespace ceres_sesync
