@@ -239,25 +239,15 @@ bool ParseVertex(const Location& at, Tag tag,
   return RotationFromQuaternion(at, v + 3, &pose->R, num_normalized);
 }
 
-// Checks a (2 + 1) x (2 + 1) or (3 + 3) x (3 + 3) information matrix. The
-// blocks that define tau and kappa (translation, rotation) must be positive
-// definite. The full matrix need not be: only those blocks enter the
-// isotropic model, and some benchmark files (5021 edges of cubicle.g2o) have
-// cross terms that make it indefinite; such edges are counted.
-template <int kD, int kSize>
-bool CheckInformation(const Location& at,
-                      const Eigen::Matrix<double, kSize, kSize>& info,
-                      G2oReadSummary* counts) {
-  constexpr int kR = kSize - kD;  // Size of the rotation block.
-  const Eigen::Matrix<double, kD, kD> info_tt =
-      info.template topLeftCorner<kD, kD>();
-  const Eigen::Matrix<double, kR, kR> info_RR =
-      info.template bottomRightCorner<kR, kR>();
-  if (info_tt.llt().info() != Eigen::Success) {
-    return at.Fail("translational information block is not positive definite");
-  }
-  if (info_RR.llt().info() != Eigen::Success) {
-    return at.Fail("rotational information block is not positive definite");
+// (kappa, tau) of an edge. Some benchmark files (5021 edges of cubicle.g2o)
+// have cross terms that make the full information matrix indefinite although
+// the translation and rotation blocks are positive definite; such edges are
+// accepted (only the blocks enter the model) and counted.
+bool SetPrecisions(const Location& at, const Eigen::MatrixXd& info,
+                   RelativePoseMeasurement* m, G2oReadSummary* counts) {
+  std::string message;
+  if (!IsotropicPrecisions(info, &m->kappa, &m->tau, &message)) {
+    return at.Fail(message);
   }
   if (info.llt().info() != Eigen::Success) ++counts->num_indefinite_information;
   return true;
@@ -293,11 +283,7 @@ bool ParseEdge(const Location& at, Tag tag,
     }
     Eigen::Matrix3d info;
     info << I11, I12, I13, I12, I22, I23, I13, I23, I33;
-    if (!CheckInformation<2>(at, info, counts)) return false;
-    // trace(inverse([[I11, I12], [I12, I22]])) = (I11 + I22) / det.
-    const double det = I11 * I22 - I12 * I12;
-    m->tau = 2 * det / (I11 + I22);
-    m->kappa = I33;
+    if (!SetPrecisions(at, info, m, counts)) return false;
   } else {
     double v[28];
     if (!ParseNumbers(at, tokens, 3, 28, v)) return false;
@@ -311,17 +297,7 @@ bool ParseEdge(const Location& at, Tag tag,
     for (int r = 0; r < 6; ++r) {
       for (int c = r; c < 6; ++c) info(r, c) = info(c, r) = *u++;
     }
-    if (!CheckInformation<3>(at, info, counts)) return false;
-    const Eigen::Matrix3d info_tt = info.topLeftCorner<3, 3>();
-    const Eigen::Matrix3d info_RR = info.bottomRightCorner<3, 3>();
-    m->tau = 3 / info_tt.inverse().trace();
-    m->kappa = 3 / (2 * info_RR.inverse().trace());
-  }
-  if (!(std::isfinite(m->tau) && m->tau > 0 && std::isfinite(m->kappa) &&
-        m->kappa > 0)) {
-    return at.Fail(
-        "information matrix gives non-finite or non-positive "
-        "precisions");
+    if (!SetPrecisions(at, info, m, counts)) return false;
   }
   return true;
 }
@@ -627,6 +603,47 @@ void AppendVertexLines(const PoseGraph& graph, const Poses& poses,
 }
 
 }  // namespace
+
+bool IsotropicPrecisions(const Eigen::MatrixXd& information, double* kappa,
+                         double* tau, std::string* error) {
+  auto fail = [&](const char* message) {
+    if (error) *error = message;
+    return false;
+  };
+  const int size = static_cast<int>(information.rows());
+  if ((size != 3 && size != 6) || information.cols() != size) {
+    return fail("information matrix must be 3 x 3 (2D) or 6 x 6 (3D)");
+  }
+  if (!information.allFinite()) {
+    return fail("information matrix has non-finite entries");
+  }
+  const int d = size == 3 ? 2 : 3;
+  const Eigen::MatrixXd info_tt = information.topLeftCorner(d, d);
+  const Eigen::MatrixXd info_RR =
+      information.bottomRightCorner(size - d, size - d);
+  if (info_tt.llt().info() != Eigen::Success) {
+    return fail("translational information block is not positive definite");
+  }
+  if (info_RR.llt().info() != Eigen::Success) {
+    return fail("rotational information block is not positive definite");
+  }
+  if (d == 2) {
+    // tr([[I11, I12], [I12, I22]]^-1) = (I11 + I22) / det.
+    const double det =
+        info_tt(0, 0) * info_tt(1, 1) - info_tt(0, 1) * info_tt(0, 1);
+    *tau = 2 * det / (info_tt(0, 0) + info_tt(1, 1));
+    *kappa = info_RR(0, 0);
+  } else {
+    *tau = 3 / info_tt.inverse().trace();
+    *kappa = 3 / (2 * info_RR.inverse().trace());
+  }
+  if (!(std::isfinite(*tau) && *tau > 0 && std::isfinite(*kappa) &&
+        *kappa > 0)) {
+    return fail(
+        "information matrix gives non-finite or non-positive precisions");
+  }
+  return true;
+}
 
 bool ReadG2oFile(const std::string& path, const G2oReadOptions& options,
                  PoseGraph* graph, std::string* error,

@@ -93,6 +93,17 @@ bool ReadG2o(std::istream& in, const std::string& name_for_messages,
              const G2oReadOptions& options, PoseGraph* graph,
              std::string* error, G2oReadSummary* summary = nullptr);
 
+// The isotropic precisions of a symmetric information matrix in g2o's order
+// (translation block first; 3 x 3 for d = 2, 6 x 6 for d = 3), with the
+// SE-Sync reference convention that reproduces the paper's objective values:
+//   d = 2: tau = 2 / tr(I_tt^-1), kappa = I_33;
+//   d = 3: tau = 3 / tr(I_tt^-1), kappa = 3 / (2 tr(I_RR^-1)).
+// Only the translation and rotation blocks enter; they must be positive
+// definite (the full matrix need not be). Returns false with a message
+// otherwise, or if the entries or the precisions are not finite.
+bool IsotropicPrecisions(const Eigen::MatrixXd& information, double* kappa,
+                         double* tau, std::string* error);
+
 // Writes the whole graph to `path`: VERTEX lines for `poses` if it is not
 // empty (one per pose, with the original vertex ids, in dense order), one
 // EDGE line per measurement with an isotropic information matrix that

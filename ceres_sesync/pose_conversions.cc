@@ -7,6 +7,7 @@
 #include "Eigen/Cholesky"
 #include "Eigen/LU"
 #include "Eigen/SVD"
+#include "ceres_sesync/g2o_io.h"
 
 namespace ceres_sesync {
 namespace {
@@ -77,62 +78,6 @@ bool CheckGraphForAdapter(const PoseGraph& graph, int d, const char* adapter,
 }
 
 // The same convention as the g2o reader (g2o_io.cc, ParseEdge).
-bool IsotropicPrecisions2d(const Eigen::Matrix3d& information, double* kappa,
-                           double* tau, std::string* error) {
-  if (!information.allFinite()) {
-    return ConversionFail("information matrix has non-finite entries", error);
-  }
-  // Upper triangle, as in a g2o line.
-  const double I11 = information(0, 0), I12 = information(0, 1),
-               I22 = information(1, 1), I33 = information(2, 2);
-  const double det = I11 * I22 - I12 * I12;
-  if (!(I11 > 0 && det > 0)) {
-    return ConversionFail(
-        "translational information block is not positive definite", error);
-  }
-  if (!(I33 > 0)) {
-    return ConversionFail(
-        "rotational information block is not positive definite", error);
-  }
-  // trace(inverse([[I11, I12], [I12, I22]])) = (I11 + I22) / det.
-  *tau = 2 * det / (I11 + I22);
-  *kappa = I33;
-  if (!(std::isfinite(*tau) && *tau > 0 && std::isfinite(*kappa))) {
-    return ConversionFail(
-        "information matrix gives non-finite or non-positive precisions",
-        error);
-  }
-  return true;
-}
-
-bool IsotropicPrecisions3d(const Eigen::Matrix<double, 6, 6>& information,
-                           double* kappa, double* tau, std::string* error) {
-  if (!information.allFinite()) {
-    return ConversionFail("information matrix has non-finite entries", error);
-  }
-  const Eigen::Matrix3d info_tt =
-      information.topLeftCorner<3, 3>().selfadjointView<Eigen::Upper>();
-  const Eigen::Matrix3d info_RR =
-      information.bottomRightCorner<3, 3>().selfadjointView<Eigen::Upper>();
-  if (info_tt.llt().info() != Eigen::Success) {
-    return ConversionFail(
-        "translational information block is not positive definite", error);
-  }
-  if (info_RR.llt().info() != Eigen::Success) {
-    return ConversionFail(
-        "rotational information block is not positive definite", error);
-  }
-  *tau = 3 / info_tt.inverse().trace();
-  *kappa = 3 / (2 * info_RR.inverse().trace());
-  if (!(std::isfinite(*tau) && *tau > 0 && std::isfinite(*kappa) &&
-        *kappa > 0)) {
-    return ConversionFail(
-        "information matrix gives non-finite or non-positive precisions",
-        error);
-  }
-  return true;
-}
-
 bool MeasurementFromCeres2d(int index, int64_t id_begin, int64_t id_end,
                             double x, double y, double yaw_radians,
                             const Eigen::Matrix3d& information,
@@ -142,7 +87,7 @@ bool MeasurementFromCeres2d(int index, int64_t id_begin, int64_t id_end,
     return ConversionFail(name + ": non-finite relative pose", error);
   }
   std::string message;
-  if (!IsotropicPrecisions2d(information, &m->kappa, &m->tau, &message)) {
+  if (!IsotropicPrecisions(information, &m->kappa, &m->tau, &message)) {
     return ConversionFail(name + ": " + message, error);
   }
   const Pose pose = PoseFromXYYaw(x, y, yaw_radians);
@@ -168,7 +113,7 @@ bool MeasurementFromCeres3d(int index, int64_t id_begin, int64_t id_end,
                           error);
   }
   std::string message;
-  if (!IsotropicPrecisions3d(information, &m->kappa, &m->tau, &message)) {
+  if (!IsotropicPrecisions(information, &m->kappa, &m->tau, &message)) {
     return ConversionFail(name + ": " + message, error);
   }
   const Pose pose = PoseFromQuaternionTranslation(q, p);

@@ -245,14 +245,6 @@ bool CheckPoseForConversion(const Pose& pose, int d, const std::string& what,
 bool CheckGraphForAdapter(const PoseGraph& graph, int d, const char* adapter,
                           std::string* error);
 
-// (kappa, tau) from an information matrix, with the g2o reader's convention.
-// TODO(ceres_sesync): use the g2o reader's own function once g2o_io.h exposes
-// it, instead of this duplicate.
-bool IsotropicPrecisions2d(const Eigen::Matrix3d& information, double* kappa,
-                           double* tau, std::string* error);
-bool IsotropicPrecisions3d(const Eigen::Matrix<double, 6, 6>& information,
-                           double* kappa, double* tau, std::string* error);
-
 // Builds the measurement of one Ceres-example constraint (number `index` in
 // the range, ids for messages).
 bool MeasurementFromCeres2d(int index, int64_t id_begin, int64_t id_end,
