@@ -1,6 +1,7 @@
 #include "ceres_sesync/internal/certificate_matrix.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "glog/logging.h"
 
@@ -66,7 +67,8 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
   factor_.analyzePattern(K_);
 }
 
-bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c) {
+bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c,
+                                  bool bound_backward_error) {
   std::copy(base_values_.begin(), base_values_.end(), K_.valuePtr());
   const int d = d_;
   int k = 0;
@@ -81,6 +83,10 @@ bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c) {
   }
   factor_.factorize(K_);
   if (factor_.info() != Eigen::Success) return false;
+  if (!bound_backward_error) {
+    backward_error_ = proven_shift_ = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
   backward_error_ = factor_.BackwardErrorBound();
   proven_shift_ = c + backward_error_;
   VLOG(1) << "K_c factorized: c " << c << " backward error " << backward_error_;

@@ -28,13 +28,21 @@ class CertificateMatrix {
   explicit CertificateMatrix(const SESyncProblem& problem);
 
   // Assembles and factorizes K_c for the d x dn multipliers Lambda. Returns
-  // true iff the Cholesky factorization ran to completion.
-  bool Factorize(const Eigen::MatrixXd& Lambda, double c);
+  // true iff the Cholesky factorization ran to completion. Without
+  // `bound_backward_error` (for preconditioning, not proofs) proven_shift()
+  // is not computed.
+  bool Factorize(const Eigen::MatrixXd& Lambda, double c,
+                 bool bound_backward_error = true);
 
   // After a successful Factorize(): x = (S + cI)^{-1} y, y and x in R^{dn}.
   void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;
   // The same for the columns of Y (dn x k).
   void SolveShifted(const Eigen::MatrixXd& Y, Eigen::MatrixXd* X) const;
+  // After a successful Factorize(): a copy of the factor for fast repeated
+  // solves X = V (S + cI)^{-1} with V of size r x dn (SolveRowsTail with
+  // offset translation_size()).
+  SparseCholeskyFactor ExtractFactor() { return factor_.ExtractFactor(); }
+  int translation_size() const { return translation_size_; }
 
   // After a successful Factorize(Lambda, c): c + delta, where delta bounds
   // the factorization's backward error ||L L^T - P K_c P^T||_2 (see

@@ -35,20 +35,24 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
     return;
   }
   if (type == PreconditionerType::kRegularizedQ) {
-    augmented_ = std::make_unique<CertificateMatrix>(problem);
-    CHECK(augmented_->Factorize(Eigen::MatrixXd::Zero(d, d * n), eps))
+    CertificateMatrix augmented(problem);
+    CHECK(augmented.Factorize(Eigen::MatrixXd::Zero(d, d * n), eps,
+                              /*bound_backward_error=*/false))
         << "regularized Q preconditioner: factorization failed";
+    factor_ = augmented.ExtractFactor();
+    translation_size_ = augmented.translation_size();
     return;
   }
   SparseMatrix regularized = D;
   for (int k = 0; k < regularized.rows(); ++k) {
     regularized.coeffRef(k, k) += eps;
   }
-  factor_ = std::make_unique<CholmodFactor>();
-  ConfigureCholmod(/*supernodal=*/false, factor_.get());
-  factor_->compute(regularized);
-  CHECK(factor_->info() == Eigen::Success)
+  CholmodFactor factor;
+  ConfigureCholmod(/*supernodal=*/false, &factor);
+  factor.compute(regularized);
+  CHECK(factor.info() == Eigen::Success)
       << "regularized Cholesky preconditioner failed";
+  factor_ = factor.ExtractFactor();
 }
 
 void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
@@ -61,14 +65,11 @@ void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
       BlockDiagonalMultiply(V, block_inverses_, d_, X);
       return;
     case PreconditionerType::kSparseCholesky:
-      *X = factor_->solve(V.transpose()).transpose();
+      factor_.SolveRows(V, X);
       return;
-    case PreconditionerType::kRegularizedQ: {
-      Eigen::MatrixXd Xt;
-      augmented_->SolveShifted(Eigen::MatrixXd(V.transpose()), &Xt);
-      *X = Xt.transpose();
+    case PreconditionerType::kRegularizedQ:
+      factor_.SolveRowsTail(V, translation_size_, X);
       return;
-    }
   }
 }
 
@@ -94,16 +95,15 @@ void SESyncCost::Gradient(Eigen::MatrixXd* gradient) {
 void SESyncCost::HessianVector(const Eigen::MatrixXd& V, Eigen::MatrixXd* hv) {
   // Eq. (44): Proj_Y(2 V Q - V_i SymBlockDiag(Y^T 2 Y Q)_i).
   ++hessian_vector_products_;
-  Eigen::MatrixXd VQ, V_lambda;
-  problem_->MultiplyQ(V, &VQ);
-  BlockDiagonalMultiply(V, lambda_, d_, &V_lambda);
-  ProjectToStiefelProductTangent(Y_, 2 * (VQ - V_lambda), d_, hv);
+  problem_->MultiplyQ(V, &vq_);
+  BlockDiagonalMultiply(V, lambda_, d_, &v_lambda_);
+  vq_ = 2 * (vq_ - v_lambda_);
+  ProjectToStiefelProductTangent(Y_, vq_, d_, hv);
 }
 
 void SESyncCost::Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) {
-  Eigen::MatrixXd X;
-  preconditioner_->Apply(V, &X);
-  ProjectToStiefelProductTangent(Y_, X, d_, pv);
+  preconditioner_->Apply(V, &vq_);
+  ProjectToStiefelProductTangent(Y_, vq_, d_, pv);
 }
 
 void SESyncCost::Retract(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,

@@ -5,8 +5,6 @@
 #ifndef CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 #define CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 
-#include <memory>
-
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/riemannian_trust_region.h"
@@ -37,8 +35,10 @@ class SESyncPreconditioner {
   int d_;
   PreconditionerType type_;
   Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.
-  std::unique_ptr<CholmodFactor> factor_;
-  std::unique_ptr<CertificateMatrix> augmented_;
+  // D + eps I (kSparseCholesky) or K_eps (kRegularizedQ, whose first
+  // translation_size_ unknowns are the translations).
+  SparseCholeskyFactor factor_;
+  int translation_size_ = 0;
 };
 
 class SESyncCost : public RiemannianCostFunction {
@@ -66,6 +66,7 @@ class SESyncCost : public RiemannianCostFunction {
   const SESyncPreconditioner* preconditioner_;
   int d_;
   Eigen::MatrixXd Y_, YQ_, lambda_;
+  Eigen::MatrixXd vq_, v_lambda_;  // Workspace of HessianVector/Precondition.
   int hessian_vector_products_ = 0;
 };
 

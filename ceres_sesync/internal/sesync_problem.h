@@ -21,6 +21,7 @@
 #include "Eigen/CholmodSupport"
 #include "Eigen/Core"
 #include "Eigen/SparseCore"
+#include "ceres_sesync/internal/sparse_cholesky_factor.h"
 #include "ceres_sesync/pose_graph.h"
 
 namespace ceres_sesync::internal {
@@ -40,6 +41,9 @@ class CholmodFactor
   // summation orders, and ||E||_2 <= ||E||_inf for the symmetric error E.
   // O(nnz(L)) plus a copy of the factor.
   double BackwardErrorBound();
+  // After a successful factorization: a copy of the factor for fast solves
+  // with r x N right-hand sides.
+  SparseCholeskyFactor ExtractFactor();
 };
 
 // Sets a true LL^T factorization (which fails on matrices that are not
@@ -77,8 +81,9 @@ class SESyncProblem {
  private:
   int d_ = 0, n_ = 0;
   bool ok_ = false;
-  SparseMatrix D_, Lrho_, Vbar_, VbarT_, Lbar_;
+  SparseMatrix D_, Lrho_, Vbar_, VbarT_, minus_Vbar_, Lbar_;
   std::unique_ptr<CholmodFactor> lbar_factor_;
+  SparseCholeskyFactor lbar_solver_;  // The same factor, for MultiplyQ.
 };
 
 // out_i = V_i * Lambda_i for the d x d blocks Lambda (d x dn) and the r x d
