@@ -60,7 +60,7 @@ TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
     out.h_eta += alpha * h_delta;
     e_pe = e_pe_new;
     r += alpha * h_delta;
-    cost->ProjectToTangent(Eigen::MatrixXd(r), &r);
+    cost->ProjectToTangent(r, &r);
     if (std::sqrt(Inner(r, r)) <= target) return out;
     cost->Precondition(r, &z);
     const double z_r_old = z_r;

@@ -53,22 +53,40 @@ void SymBlockDiagKernel(const double* a, const double* b, int p, int d, int n,
   }
 }
 
-// out_i = V_i - Y_i sym(Y_i^T V_i). out may alias v: each output coefficient
-// (j, k) reads only V_i(j, k) of V_i.
-template <int D>
+// out_i = V_i - Y_i sym(Y_i^T V_i). out may alias v: each block is read
+// completely before it is written. R is the compile-time number of rows (r)
+// or Eigen::Dynamic.
+template <int D, int R = Eigen::Dynamic>
 void TangentProjectionKernel(const double* y, const double* v, int r, int d,
                              int n, double* out) {
+  using Block = Eigen::Matrix<double, R, D>;
   Small<D> product(d, d);
   Small<D> sym(d, d);
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(r) * d;
   for (int i = 0; i < n; ++i) {
-    ConstBlock<D> y_i(y + i * stride, r, d);
-    ConstBlock<D> v_i(v + i * stride, r, d);
+    Eigen::Map<const Block> y_i(y + i * stride, r, d);
+    Eigen::Map<const Block> v_i(v + i * stride, r, d);
     product.noalias() = y_i.transpose().lazyProduct(v_i);
     sym = 0.5 * (product + product.transpose());
-    MutableBlock<D> out_i(out + i * stride, r, d);
+    Eigen::Map<Block> out_i(out + i * stride, r, d);
     out_i = v_i - y_i.lazyProduct(sym);
   }
+}
+
+// TangentProjectionKernel<D> with the common staircase ranks r = d + 1 ..
+// d + 3 unrolled at compile time (the inner solver's most frequent call).
+template <int D>
+void TangentProjectionDispatch(const double* y, const double* v, int r, int d,
+                               int n, double* out) {
+  if constexpr (D != Eigen::Dynamic) {
+    if (r == D + 1)
+      return TangentProjectionKernel<D, D + 1>(y, v, r, d, n, out);
+    if (r == D + 2)
+      return TangentProjectionKernel<D, D + 2>(y, v, r, d, n, out);
+    if (r == D + 3)
+      return TangentProjectionKernel<D, D + 3>(y, v, r, d, n, out);
+  }
+  TangentProjectionKernel<D>(y, v, r, d, n, out);
 }
 
 // Orthogonal polar factor of the r x d matrix x via a thin SVD; robust to rank
@@ -589,7 +607,7 @@ void ProjectToStiefelProductTangent(const Eigen::MatrixXd& Y,
   }
   const int n = static_cast<int>(Y.cols() / d);
   out->resize(Y.rows(), Y.cols());  // No-op (keeps data) when out == &V.
-  CERES_SESYNC_DISPATCH_ON_D(d, TangentProjectionKernel, Y.data(), V.data(),
+  CERES_SESYNC_DISPATCH_ON_D(d, TangentProjectionDispatch, Y.data(), V.data(),
                              static_cast<int>(Y.rows()), d, n, out->data());
 }
 
