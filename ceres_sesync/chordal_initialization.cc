@@ -19,7 +19,7 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
   const SparseMatrix L11 = L.bottomRightCorner(dn - d, dn - d);
   const Eigen::MatrixXd L10 = L.bottomLeftCorner(dn - d, d);
   CholmodFactor factor;
-  ConfigureCholmod(/*supernodal=*/false, &factor);
+  ConfigureCholmod(CholmodLayout::kSimplicial, &factor);
   factor.compute(L11);
   if (factor.info() != Eigen::Success) return false;
   const Eigen::MatrixXd Xt = factor.solve(-L10);

@@ -46,7 +46,9 @@ TEST_P(SparseCholeskyFactorTest, SolveRowsMatchesDenseSolve) {
   const int n = 300;
   const SparseMatrix A = RandomSpd(n, 900, 7);
   CholmodFactor factor;
-  ConfigureCholmod(supernodal, &factor);
+  ConfigureCholmod(
+      supernodal ? CholmodLayout::kSupernodal : CholmodLayout::kSimplicial,
+      &factor);
   factor.compute(A);
   ASSERT_EQ(factor.info(), Eigen::Success);
   const SparseCholeskyFactor solver = factor.ExtractFactor();
@@ -74,6 +76,31 @@ TEST_P(SparseCholeskyFactorTest, SolveRowsMatchesDenseSolve) {
       dense.llt().solve(padded.transpose()).transpose();
   ASSERT_EQ(tail_X.cols(), n - offset);
   EXPECT_LT((tail_X - full.rightCols(n - offset)).norm() / full.norm(), 1e-12);
+}
+
+// The certificate relies on the factorization failing for matrices that are
+// not positive definite, in every layout (a simplicial LDL^T would succeed).
+TEST(ConfigureCholmod, EveryLayoutRejectsIndefiniteMatrices) {
+  const int n = 200;
+  SparseMatrix A = RandomSpd(n, 600, 11);
+  const Eigen::MatrixXd dense =
+      Eigen::MatrixXd(A).selfadjointView<Eigen::Lower>();
+  const double lambda_min =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dense).eigenvalues()(0);
+  for (CholmodLayout layout :
+       {CholmodLayout::kSimplicial, CholmodLayout::kSupernodal,
+        CholmodLayout::kAutomatic}) {
+    for (double shift : {-1.001 * lambda_min, -0.999 * lambda_min}) {
+      SparseMatrix shifted = A;
+      for (int k = 0; k < n; ++k) shifted.coeffRef(k, k) += shift;
+      CholmodFactor factor;
+      ConfigureCholmod(layout, &factor);
+      factor.compute(shifted);
+      // shift > -lambda_min: PD; shift < -lambda_min: one negative eigenvalue.
+      EXPECT_EQ(factor.info() == Eigen::Success, shift > -lambda_min)
+          << "layout " << static_cast<int>(layout) << " shift " << shift;
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(AllKernels, SparseCholeskyFactorTest,

@@ -63,7 +63,7 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
       }
     }
   }
-  ConfigureCholmod(/*supernodal=*/true, &factor_);
+  ConfigureCholmod(CholmodLayout::kAutomatic, &factor_);
   factor_.analyzePattern(K_);
 }
 

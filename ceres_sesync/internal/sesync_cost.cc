@@ -48,7 +48,7 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
     regularized.coeffRef(k, k) += eps;
   }
   CholmodFactor factor;
-  ConfigureCholmod(/*supernodal=*/false, &factor);
+  ConfigureCholmod(CholmodLayout::kSimplicial, &factor);
   factor.compute(regularized);
   CHECK(factor.info() == Eigen::Success)
       << "regularized Cholesky preconditioner failed";

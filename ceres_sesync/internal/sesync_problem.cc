@@ -104,10 +104,15 @@ SparseCholeskyFactor CholmodFactor::ExtractFactor() {
   return SparseCholeskyFactor(m_cholmodFactor, &cholmod());
 }
 
-void ConfigureCholmod(bool supernodal, CholmodFactor* factor) {
-  factor->setMode(supernodal ? Eigen::CholmodSupernodalLLt
-                             : Eigen::CholmodSimplicialLLt);
-  factor->cholmod().print = 0;
+void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
+  factor->setMode(layout == CholmodLayout::kSimplicial
+                      ? Eigen::CholmodSimplicialLLt
+                      : Eigen::CholmodSupernodalLLt);
+  cholmod_common& common = factor->cholmod();
+  if (layout == CholmodLayout::kAutomatic) common.supernodal = CHOLMOD_AUTO;
+  // A simplicial factorization is computed as LL^T (not LDL^T) iff final_ll.
+  common.final_ll = 1;
+  common.print = 0;
 }
 
 SESyncProblem::SESyncProblem(const PoseGraph& graph)
@@ -167,7 +172,7 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph)
     return;
   }
   lbar_factor_ = std::make_unique<CholmodFactor>();
-  ConfigureCholmod(/*supernodal=*/false, lbar_factor_.get());
+  ConfigureCholmod(CholmodLayout::kSimplicial, lbar_factor_.get());
   lbar_factor_->compute(Lbar_);
   ok_ = lbar_factor_->info() == Eigen::Success;
   if (ok_) lbar_solver_ = lbar_factor_->ExtractFactor();

@@ -85,6 +85,10 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     return result;
   }
   result.eta = matrix->proven_shift();
+  if (result.eta <= eta_max) {  // Certified with a larger shift.
+    result.certified = true;
+    return result;
+  }
   // lambda_min(S) > -c: the largest eigenvalue of (S + cI)^{-1} is
   // 1 / (lambda_min + c).
   ShiftInvertOperator op(matrix);
