@@ -110,10 +110,10 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
     s.message = "the translational Laplacian is not positive definite";
     return {};
   }
+  internal::CertificateMatrix certificate(problem);
   internal::SESyncPreconditioner preconditioner(
       problem, ToInternal(options.preconditioner),
-      options.regularized_cholesky_max_condition);
-  internal::CertificateMatrix certificate(problem);
+      options.regularized_cholesky_max_condition, &certificate);
   const double scale = MaxDiagonal(problem.D());
   // Objective values below this are zero up to round-off (F is a sum of
   // squares weighted by kappa and tau).

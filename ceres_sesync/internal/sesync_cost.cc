@@ -1,6 +1,7 @@
 #include "ceres_sesync/internal/sesync_cost.h"
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "Eigen/Cholesky"
@@ -11,7 +12,8 @@ namespace ceres_sesync::internal {
 
 SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
                                            PreconditionerType type,
-                                           double max_condition)
+                                           double max_condition,
+                                           CertificateMatrix* workspace)
     : d_(problem.dimension()), type_(type) {
   if (type == PreconditionerType::kNone) return;
   const SparseMatrix& D = problem.D();
@@ -35,12 +37,16 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
     return;
   }
   if (type == PreconditionerType::kRegularizedQ) {
-    CertificateMatrix augmented(problem);
-    CHECK(augmented.Factorize(Eigen::MatrixXd::Zero(d, d * n), eps,
-                              /*bound_backward_error=*/false))
+    std::unique_ptr<CertificateMatrix> own;
+    if (workspace == nullptr) {
+      own = std::make_unique<CertificateMatrix>(problem);
+      workspace = own.get();
+    }
+    CHECK(workspace->Factorize(Eigen::MatrixXd::Zero(d, d * n), eps,
+                               /*bound_backward_error=*/false))
         << "regularized Q preconditioner: factorization failed";
-    factor_ = augmented.ExtractFactor();
-    translation_size_ = augmented.translation_size();
+    factor_ = workspace->ExtractFactor();
+    translation_size_ = workspace->translation_size();
     return;
   }
   SparseMatrix regularized = D;

@@ -25,8 +25,12 @@ enum class PreconditionerType {
 // lambda_max(D) >= lambda_max(Q) is bounded by Gershgorin.
 class SESyncPreconditioner {
  public:
+  // kRegularizedQ factorizes K_eps in `workspace` when given (sharing its
+  // symbolic analysis with the caller's certificate tests; the factor is
+  // copied, so the workspace may be refactorized afterwards).
   SESyncPreconditioner(const SESyncProblem& problem, PreconditionerType type,
-                       double max_condition);
+                       double max_condition,
+                       CertificateMatrix* workspace = nullptr);
   // X = V (D + eps I)^{-1} (or the block-Jacobi version); V is r x dn.
   void Apply(const Eigen::MatrixXd& V, Eigen::MatrixXd* X) const;
   PreconditionerType type() const { return type_; }
