@@ -2,7 +2,8 @@
 // datasets (Rosen et al., IJRR 2019, Section 6.2, Tables 1-2).
 //
 //   bench [--quick] [--repeats N] [--out_dir DIR] [--ceres_max_time S]
-//         [--poses_dir DIR] [--sesync_only] [files...]
+//         [--poses_dir DIR] [--sesync_only] [--methods LIST]
+//         [--[no]lbfgs] [--lbfgs_max_time S] [--lbfgs_repeats N] [files...]
 //
 // Without files: every .g2o in CERES_SESYNC_DATA_DIR, sorted by name
 // (--quick: tinyGrid3D, smallGrid3D, CSAIL, intel, one repeat).
@@ -12,6 +13,11 @@
 //    wall time of Solve(), which includes building the data matrices, the
 //    initialization, the staircase, the certificate and the rounding. The
 //    stage breakdown of the fastest repeat goes to bench_stages.csv.
+//  - SE-Sync (Ceres LBFGS): the same Solve() with SolverOptions::local_solver
+//    = kCeresLbfgs (ceres::GradientProblemSolver on StiefelProductManifold
+//    as the staircase's local solver), chordal initialization, limited to
+//    --lbfgs_max_time seconds (SolverOptions::max_time_s) and repeated
+//    --lbfgs_repeats times (default 1). Off with --nolbfgs.
 //  - Certify() of the SE-Sync solution (time), and of the file's own VERTEX
 //    guess when it has one (expected NOT to certify: lower bound and relative
 //    bound reported).
@@ -22,7 +28,8 @@
 // Times are the minimum and median over the repeats (the machine is shared;
 // the minimum is the least disturbed measurement). Runs from the file's
 // initial guess are repeated --odometry_repeats times (default 1): several
-// of them end at the time limit.
+// of them end at the time limit. --methods runs a subset (e.g.
+// --methods sesync,lbfgs).
 //
 // Output in --out_dir: bench.md (Markdown table + summary), bench.csv,
 // bench_stages.csv. The same Markdown is printed to stdout.
@@ -34,6 +41,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -65,7 +73,20 @@ DEFINE_string(poses_dir, "",
               "DATASET_initial.g2o here (for plot_trajectory.py).");
 DEFINE_bool(sesync_only, false,
             "Run only SE-Sync (for peak-memory measurements with "
-            "/usr/bin/time -v).");
+            "/usr/bin/time -v); same as --methods sesync.");
+DEFINE_string(methods, "sesync,lbfgs,ceres",
+              "Comma-separated methods to run: sesync (SE-Sync and Certify "
+              "of its solution), lbfgs (SE-Sync (Ceres LBFGS)), ceres "
+              "(Certify of the file's guess, Ceres PDL-GN and LM from the "
+              "chordal initialization and from the file's guess).");
+DEFINE_bool(lbfgs, true,
+            "Run SE-Sync with Ceres's LBFGS as the staircase's local solver "
+            "(row 'SE-Sync (Ceres LBFGS)'); --nolbfgs skips it.");
+DEFINE_double(lbfgs_max_time, 60,
+              "Wall-clock limit (SolverOptions::max_time_s) of each SE-Sync "
+              "(Ceres LBFGS) solve in seconds.");
+DEFINE_int32(lbfgs_repeats, 1,
+             "Repeats of SE-Sync (Ceres LBFGS) (capped by --repeats).");
 
 namespace ceres_sesync {
 namespace {
@@ -103,7 +124,7 @@ const std::map<std::string, double>& PaperOptima() {
 struct Row {
   std::string dataset;
   int n = 0, m = 0;
-  std::string method;  // SE-Sync, Certify, PDL-GN, LM.
+  std::string method;  // SE-Sync, SE-Sync (Ceres LBFGS), Certify, PDL-GN, LM.
   std::string init;    // chordal, vertices, odometry, sesync (for Certify).
   std::vector<double> times;
   double chordal_time_s = NAN;  // Part of `times` spent on the chordal init.
@@ -118,6 +139,7 @@ struct Row {
 
 struct Stages {
   std::string dataset;
+  std::string method;  // SE-Sync or SE-Sync (Ceres LBFGS).
   int n = 0, m = 0, d = 0;
   SolverSummary summary;
   double wall_s = 0;
@@ -230,7 +252,86 @@ double PeakRssMiB() {
   return NAN;
 }
 
-bool BenchDataset(const std::string& path, int repeats, std::vector<Row>* rows,
+// A short form of a level's termination message ("ceres LBFGS: Function
+// tolerance reached. |cost_change|/cost: ..." -> "Function tolerance
+// reached").
+std::string ShortTermination(const std::string& termination) {
+  std::string s = termination;
+  const std::string prefix = "ceres LBFGS: ";
+  if (s.rfind(prefix, 0) == 0) s = s.substr(prefix.size());
+  return s.substr(0, s.find('.'));
+}
+
+// Runs Solve(graph, options) `repeats` times and fills `row` (named `method`)
+// and `stage` (the fastest repeat); `poses` gets the solution. Returns false
+// if the graph is invalid.
+bool RunSESync(const PoseGraph& graph, const std::string& dataset,
+               const std::string& method, const SolverOptions& options,
+               int repeats, Row* row, Stages* stage, Poses* poses) {
+  row->dataset = stage->dataset = dataset;
+  row->method = stage->method = method;
+  row->n = stage->n = graph.num_poses;
+  row->m = stage->m = static_cast<int>(graph.measurements.size());
+  row->init = "chordal";
+  stage->d = graph.dimension;
+  for (int r = 0; r < repeats; ++r) {
+    SolverSummary summary;
+    const auto start = Clock::now();
+    *poses = Solve(graph, options, &summary);
+    const double wall = SecondsSince(start);
+    row->times.push_back(wall);
+    if (r == 0 || wall < stage->wall_s) {
+      stage->summary = summary;
+      stage->wall_s = wall;
+    }
+  }
+  const SolverSummary& s = stage->summary;
+  if (s.status == SolverSummary::Status::kInvalidInput) {
+    std::fprintf(stderr, "bench: %s: %s\n", dataset.c_str(), s.message.c_str());
+    return false;
+  }
+  row->objective = s.objective;
+  row->certified = s.certified() ? "yes" : "no";
+  if (s.certified() &&
+      !(s.relative_suboptimality_bound <=
+        options.certification_max_relative_bound * (1 + 1e-9))) {
+    // The SDP solution is certified, but the rounded poses are not within
+    // the tolerance of its lower bound (the relaxation is not exact).
+    row->certified = "SDP only (bound > " +
+                     Fmt("%g", options.certification_max_relative_bound) + ")";
+  }
+  row->lower_bound = s.lower_bound;
+  row->rel_subopt_bound = s.relative_suboptimality_bound;
+  row->iterations = s.iterations;
+  row->status = s.StatusString() + ", rank " + std::to_string(s.final_rank);
+  if (options.local_solver == SolverOptions::LocalSolver::kCeresLbfgs) {
+    // How each staircase level's LBFGS run ended (rank: reason, iterations).
+    for (const SolverSummary::Level& level : s.levels) {
+      row->status += "; " + std::to_string(level.rank) + ": " +
+                     ShortTermination(level.termination) + " (" +
+                     std::to_string(level.iterations) + " it)";
+    }
+  }
+  row->chordal_time_s = s.initialization_time_s;
+  std::fprintf(stderr, "  %-22s %8.3f s  F = %.6e  %s\n", method.c_str(),
+               Min(row->times), s.objective, row->status.c_str());
+  auto known = PaperOptima().find(dataset);
+  if (known != PaperOptima().end()) {
+    const double rel = std::abs(s.objective - known->second) / known->second;
+    if (rel > 5e-4) {
+      std::fprintf(stderr,
+                   "WARNING: %s: %s objective %.6e differs from the "
+                   "paper's %.4e by %.2e relative (> 5e-4)\n",
+                   dataset.c_str(), method.c_str(), s.objective, known->second,
+                   rel);
+      row->status += ", DIFFERS FROM PAPER";
+    }
+  }
+  return true;
+}
+
+bool BenchDataset(const std::string& path, int repeats,
+                  const std::set<std::string>& methods, std::vector<Row>* rows,
                   std::vector<Stages>* stages) {
   const std::string dataset = BaseName(path);
   PoseGraph graph;
@@ -244,90 +345,38 @@ bool BenchDataset(const std::string& path, int repeats, std::vector<Row>* rows,
   std::fprintf(stderr, "%s: d = %d, n = %d, m = %d\n", dataset.c_str(),
                graph.dimension, n, m);
 
-  // --- SE-Sync.
-  Row sesync;
-  sesync.dataset = dataset;
-  sesync.n = n;
-  sesync.m = m;
-  sesync.method = "SE-Sync";
-  sesync.init = "chordal";
-  Stages stage;
-  stage.dataset = dataset;
-  stage.n = n;
-  stage.m = m;
-  stage.d = graph.dimension;
-  Poses sesync_poses;
-  SolverOptions solver_options;  // Defaults: chordal initialization.
-  for (int r = 0; r < repeats; ++r) {
-    SolverSummary summary;
-    const auto start = Clock::now();
-    sesync_poses = Solve(graph, solver_options, &summary);
-    const double wall = SecondsSince(start);
-    sesync.times.push_back(wall);
-    if (r == 0 || wall < stage.wall_s) {
-      stage.summary = summary;
-      stage.wall_s = wall;
+  // --- SE-Sync (default options: chordal initialization, trust region) and
+  // the certification of its solution.
+  if (methods.count("sesync")) {
+    Row sesync;
+    Stages stage;
+    Poses sesync_poses;
+    if (!RunSESync(graph, dataset, "SE-Sync", SolverOptions(), repeats, &sesync,
+                   &stage, &sesync_poses)) {
+      return false;
     }
-  }
-  const SolverSummary& s = stage.summary;
-  if (s.status == SolverSummary::Status::kInvalidInput) {
-    std::fprintf(stderr, "bench: %s: %s\n", path.c_str(), s.message.c_str());
-    return false;
-  }
-  sesync.objective = s.objective;
-  sesync.certified = s.certified() ? "yes" : "no";
-  if (s.certified() &&
-      !(s.relative_suboptimality_bound <=
-        solver_options.certification_max_relative_bound * (1 + 1e-9))) {
-    // The SDP solution is certified, but the rounded poses are not within
-    // the tolerance of its lower bound (the relaxation is not exact).
-    sesync.certified =
-        "SDP only (bound > " +
-        Fmt("%g", solver_options.certification_max_relative_bound) + ")";
-  }
-  sesync.lower_bound = s.lower_bound;
-  sesync.rel_subopt_bound = s.relative_suboptimality_bound;
-  sesync.iterations = s.iterations;
-  sesync.status = s.StatusString() + ", rank " + std::to_string(s.final_rank);
-  sesync.chordal_time_s = s.initialization_time_s;
-  const double sesync_time = Min(sesync.times);
-  std::fprintf(stderr, "  SE-Sync             %8.3f s  F = %.6e  %s\n",
-               sesync_time, s.objective, sesync.status.c_str());
-  auto known = PaperOptima().find(dataset);
-  if (known != PaperOptima().end()) {
-    const double rel = std::abs(s.objective - known->second) / known->second;
-    if (rel > 5e-4) {
-      std::fprintf(stderr,
-                   "WARNING: %s: SE-Sync objective %.6e differs from the "
-                   "paper's %.4e by %.2e relative (> 5e-4)\n",
-                   dataset.c_str(), s.objective, known->second, rel);
-      sesync.status += ", DIFFERS FROM PAPER";
-    }
-  }
-  rows->push_back(sesync);
-  stages->push_back(stage);
+    rows->push_back(sesync);
+    stages->push_back(stage);
 
-  if (!FLAGS_poses_dir.empty()) {
-    std::filesystem::create_directories(FLAGS_poses_dir);
-    const std::string base = FLAGS_poses_dir + "/" + dataset;
-    const Poses initial = graph.initial_poses.empty()
-                              ? OdometryInitialization(graph)
-                              : graph.initial_poses;
-    if (!WriteG2oPoses(base + "_sesync.g2o", graph, sesync_poses, &error) ||
-        !WriteG2oPoses(base + "_initial.g2o", graph, initial, &error)) {
-      std::fprintf(stderr, "bench: %s\n", error.c_str());
+    if (!FLAGS_poses_dir.empty()) {
+      std::filesystem::create_directories(FLAGS_poses_dir);
+      const std::string base = FLAGS_poses_dir + "/" + dataset;
+      const Poses initial = graph.initial_poses.empty()
+                                ? OdometryInitialization(graph)
+                                : graph.initial_poses;
+      if (!WriteG2oPoses(base + "_sesync.g2o", graph, sesync_poses, &error) ||
+          !WriteG2oPoses(base + "_initial.g2o", graph, initial, &error)) {
+        std::fprintf(stderr, "bench: %s\n", error.c_str());
+      }
     }
-  }
 
-  // --- Certify the SE-Sync solution.
-  {
     Row row;
     row.dataset = dataset;
     row.n = n;
     row.m = m;
     row.method = "Certify";
     row.init = "sesync";
-    row.objective = s.objective;
+    row.objective = sesync.objective;
     for (int r = 0; r < repeats; ++r) {
       double t = NAN;
       CertifyInto(graph, sesync_poses, &row, &t);
@@ -337,7 +386,24 @@ bool BenchDataset(const std::string& path, int repeats, std::vector<Row>* rows,
                  Min(row.times), row.certified.c_str());
     rows->push_back(row);
   }
-  if (FLAGS_sesync_only) return true;
+
+  // --- SE-Sync with Ceres's LBFGS as the local solver, time-limited.
+  if (methods.count("lbfgs")) {
+    SolverOptions options;
+    options.local_solver = SolverOptions::LocalSolver::kCeresLbfgs;
+    options.max_time_s = FLAGS_lbfgs_max_time;
+    Row row;
+    Stages stage;
+    Poses poses;
+    if (!RunSESync(graph, dataset, "SE-Sync (Ceres LBFGS)", options,
+                   std::max(1, std::min(repeats, FLAGS_lbfgs_repeats)), &row,
+                   &stage, &poses)) {
+      return false;
+    }
+    rows->push_back(row);
+    stages->push_back(stage);
+  }
+  if (!methods.count("ceres")) return true;
 
   // --- Certify the file's own initial guess.
   if (!graph.initial_poses.empty()) {
@@ -413,7 +479,8 @@ std::string CsvField(const std::string& s) {
 int main(int argc, char** argv) {
   using namespace ceres_sesync;
   gflags::SetUsageMessage(
-      "bench [--quick] [--repeats N] [--out_dir DIR] [files...]\n"
+      "bench [--quick] [--repeats N] [--out_dir DIR] [--methods LIST] "
+      "[files...]\n"
       "SE-Sync vs Ceres PDL-GN/LM on pose-graph datasets.");
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   google::InitGoogleLogging(argv[0]);
@@ -421,6 +488,25 @@ int main(int argc, char** argv) {
   if (FLAGS_minloglevel < google::GLOG_WARNING) {
     FLAGS_minloglevel = google::GLOG_WARNING;
   }
+
+  std::set<std::string> methods;
+  {
+    std::stringstream list(FLAGS_methods);
+    std::string method;
+    while (std::getline(list, method, ',')) {
+      if (method.empty()) continue;
+      if (method != "sesync" && method != "lbfgs" && method != "ceres") {
+        std::fprintf(stderr,
+                     "bench: unknown method '%s' in --methods (sesync, lbfgs, "
+                     "ceres)\n",
+                     method.c_str());
+        return 2;
+      }
+      methods.insert(method);
+    }
+  }
+  if (FLAGS_sesync_only) methods = {"sesync"};
+  if (!FLAGS_lbfgs) methods.erase("lbfgs");
 
   std::vector<std::string> files(argv + 1, argv + argc);
   int repeats = std::max(1, FLAGS_repeats);
@@ -453,7 +539,7 @@ int main(int argc, char** argv) {
   std::vector<Stages> stages;
   int failures = 0;
   for (const std::string& file : files) {
-    if (!BenchDataset(file, repeats, &rows, &stages)) ++failures;
+    if (!BenchDataset(file, repeats, methods, &rows, &stages)) ++failures;
   }
 
   // Speedups relative to SE-Sync of the same dataset.
@@ -462,8 +548,9 @@ int main(int argc, char** argv) {
     if (r.method == "SE-Sync") sesync_time[r.dataset] = Min(r.times);
   }
   for (Row& r : rows) {
-    if (r.method == "SE-Sync" || r.method == "PDL-GN" || r.method == "LM") {
-      r.speedup = Min(r.times) / sesync_time[r.dataset];
+    auto sesync = sesync_time.find(r.dataset);
+    if (r.method != "Certify" && sesync != sesync_time.end()) {
+      r.speedup = Min(r.times) / sesync->second;
     }
   }
 
@@ -485,6 +572,18 @@ int main(int argc, char** argv) {
   }
   const double geomean = count ? std::exp(log_sum / count) : NAN;
 
+  // Summary: SE-Sync (Ceres LBFGS) / SE-Sync (trust region).
+  double lbfgs_log_sum = 0;
+  int lbfgs_count = 0, lbfgs_rows = 0, lbfgs_certified = 0;
+  for (const Row& r : rows) {
+    if (r.method != "SE-Sync (Ceres LBFGS)") continue;
+    ++lbfgs_rows;
+    if (r.certified == "yes") ++lbfgs_certified;
+    if (std::isnan(r.speedup)) continue;
+    lbfgs_log_sum += std::log(r.speedup);
+    ++lbfgs_count;
+  }
+
   std::ostringstream md;
   md << "| dataset | n | m | method | init | time min [s] | time median [s] "
         "| chordal [s] | objective | certified | rel. subopt. bound | "
@@ -500,13 +599,13 @@ int main(int argc, char** argv) {
        << Fmt("%.2f", r.speedup) << " | " << r.status << " |\n";
   }
   md << "\nStage breakdown of SE-Sync (fastest repeat), seconds:\n\n"
-        "| dataset | d | n | m | data | init | optimize | verify | round | "
-        "total | rank | iterations | Hv products |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| dataset | method | d | n | m | data | init | optimize | verify | "
+        "round | total | rank | iterations | Hv products |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Stages& st : stages) {
     const SolverSummary& s = st.summary;
-    md << "| " << st.dataset << " | " << st.d << " | " << st.n << " | " << st.m
-       << " | " << Fmt("%.4f", s.data_time_s) << " | "
+    md << "| " << st.dataset << " | " << st.method << " | " << st.d << " | "
+       << st.n << " | " << st.m << " | " << Fmt("%.4f", s.data_time_s) << " | "
        << Fmt("%.4f", s.initialization_time_s) << " | "
        << Fmt("%.4f", s.optimization_time_s) << " | "
        << Fmt("%.4f", s.verification_time_s) << " | "
@@ -514,11 +613,22 @@ int main(int argc, char** argv) {
        << " | " << s.final_rank << " | " << s.iterations << " | "
        << s.hessian_vector_products << " |\n";
   }
-  if (!FLAGS_sesync_only) {
+  if (count > 0) {
     md << "\nGeometric mean of PDL-GN(chordal) / SE-Sync time over " << count
        << " datasets: " << Fmt("%.2f", geomean) << "; SE-Sync (including its "
        << "certification) is faster on " << sesync_faster << " of " << count
        << (slower.empty() ? "" : " (slower on: " + slower + ")") << ".\n";
+  }
+  if (lbfgs_rows > 0) {
+    md << "\nSE-Sync (Ceres LBFGS): certified on " << lbfgs_certified << " of "
+       << lbfgs_rows << " datasets; time limit " << FLAGS_lbfgs_max_time
+       << " s, repeats " << std::max(1, std::min(repeats, FLAGS_lbfgs_repeats));
+    if (lbfgs_count > 0) {
+      md << "; geometric mean of its time / SE-Sync (trust region) time over "
+         << lbfgs_count
+         << " datasets: " << Fmt("%.2f", std::exp(lbfgs_log_sum / lbfgs_count));
+    }
+    md << ".\n";
   }
   md << "Repeats: " << repeats << " (runs from the file's initial guess: "
      << std::max(1, std::min(repeats, FLAGS_odometry_repeats))
@@ -544,8 +654,8 @@ int main(int argc, char** argv) {
            "objective,certified,lower_bound,rel_subopt_bound,iterations,"
            "speedup,status\n";
     for (const Row& r : rows) {
-      out << r.dataset << "," << r.n << "," << r.m << "," << r.method << ","
-          << r.init << "," << Fmt("%.6g", Min(r.times)) << ","
+      out << r.dataset << "," << r.n << "," << r.m << "," << CsvField(r.method)
+          << "," << r.init << "," << Fmt("%.6g", Min(r.times)) << ","
           << Fmt("%.6g", Median(r.times)) << ","
           << Fmt("%.6g", r.chordal_time_s) << "," << Fmt("%.10g", r.objective)
           << "," << r.certified << "," << Fmt("%.10g", r.lower_bound) << ","
@@ -558,7 +668,7 @@ int main(int argc, char** argv) {
     std::ofstream out(FLAGS_out_dir + "/bench_stages.csv");
     out << "dataset,d,n,m,wall_s,data_s,initialization_s,optimization_s,"
            "verification_s,rounding_s,total_s,rank,iterations,"
-           "hessian_vector_products,status\n";
+           "hessian_vector_products,status,method\n";
     for (const Stages& st : stages) {
       const SolverSummary& s = st.summary;
       out << st.dataset << "," << st.d << "," << st.n << "," << st.m << ","
@@ -566,7 +676,7 @@ int main(int argc, char** argv) {
           << "," << s.optimization_time_s << "," << s.verification_time_s << ","
           << s.rounding_time_s << "," << s.total_time_s << "," << s.final_rank
           << "," << s.iterations << "," << s.hessian_vector_products << ","
-          << CsvField(s.StatusString()) << "\n";
+          << CsvField(s.StatusString()) << "," << CsvField(st.method) << "\n";
     }
   }
   return failures ? 1 : 0;
