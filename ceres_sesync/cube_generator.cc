@@ -59,6 +59,38 @@ Eigen::MatrixXd HeadingRotation(int d, const Eigen::Vector3d& forward) {
   return R;
 }
 
+// The lattice offsets of the loop-closure candidates of a pose: every
+// nonzero integer offset o (in the first d coordinates) with |o| <= radius.
+// The 2d unit offsets come first, in the order -x, +x, -y, +y, -z, +z (the
+// order of the generator before longer offsets existed), then the others in
+// lexicographic order.
+std::vector<LatticePoint> LoopClosureOffsets(int d, double radius) {
+  std::vector<LatticePoint> offsets;
+  for (int axis = 0; axis < d; ++axis) {
+    for (int step : {-1, 1}) {
+      LatticePoint o = {0, 0, 0};
+      o[axis] = step;
+      offsets.push_back(o);
+    }
+  }
+  // Squared lengths are integers, so a tolerance of 1e-3 on the squared
+  // radius changes nothing else and admits sqrt(k) given to a few digits
+  // (1.732 for sqrt(3)).
+  const double max_squared = radius * radius + 1e-3;
+  const int reach = static_cast<int>(std::floor(std::sqrt(max_squared)));
+  const int reach_z = d == 3 ? reach : 0;
+  for (int x = -reach; x <= reach; ++x) {
+    for (int y = -reach; y <= reach; ++y) {
+      for (int z = -reach_z; z <= reach_z; ++z) {
+        const int squared = x * x + y * y + z * z;
+        if (squared <= 1 || squared > max_squared) continue;
+        offsets.push_back({x, y, z});
+      }
+    }
+  }
+  return offsets;
+}
+
 }  // namespace
 
 double ExpectedGroundTruthObjective(int dimension, int num_measurements,
@@ -89,6 +121,9 @@ bool GenerateCube(const CubeOptions& options, PoseGraph* graph,
   const double p_lc = options.loop_closure_probability;
   if (!(p_lc >= 0 && p_lc <= 1)) {
     return fail("loop closure probability must be in [0, 1]");
+  }
+  if (!(options.loop_closure_radius >= 1 && options.loop_closure_radius <= 4)) {
+    return fail("loop closure radius must be in [1, 4] lattice units");
   }
   if (!(options.kappa > 0 && std::isfinite(options.kappa))) {
     return fail("kappa must be finite and positive");
@@ -137,17 +172,23 @@ bool GenerateCube(const CubeOptions& options, PoseGraph* graph,
     for (int k = 0; k < d; ++k) e.t[k] += sigma * SampleStandardNormal(&rng);
     g.measurements.push_back(std::move(e));
   };
+  // The offset set is symmetric, so each unordered pair is met twice; it is
+  // drawn once, from its later pose.
+  const std::vector<LatticePoint> offsets =
+      LoopClosureOffsets(d, options.loop_closure_radius);
   for (int j = 1; j < n; ++j) {
     add_measurement(j - 1, j);
-    for (int axis = 0; axis < d; ++axis) {
-      for (int step : {-1, 1}) {
-        LatticePoint q = path[j];
-        q[axis] += step;
-        if (q[axis] < 0 || q[axis] >= s) continue;
-        const int i = index_of_point[flat(q)];
-        if (i >= j - 1) continue;  // later, or the odometry predecessor
-        if (SampleUniform01(&rng) < p_lc) add_measurement(i, j);
+    for (const LatticePoint& o : offsets) {
+      LatticePoint q = path[j];
+      bool inside = true;
+      for (int k = 0; k < 3; ++k) {
+        q[k] += o[k];
+        inside = inside && q[k] >= 0 && (k >= d ? q[k] == 0 : q[k] < s);
       }
+      if (!inside) continue;
+      const int i = index_of_point[flat(q)];
+      if (i >= j - 1) continue;  // later, or the odometry predecessor
+      if (SampleUniform01(&rng) < p_lc) add_measurement(i, j);
     }
   }
   if (graph) *graph = std::move(g);

@@ -6,6 +6,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -136,6 +137,105 @@ TEST(GenerateCube, CandidateCountMatchesLatticeFormula) {
   }
 }
 
+// Unordered pairs {i, j}, |i - j| > 1, whose true positions are at most
+// `max_distance` apart (brute force).
+int CountPairsWithin(const Poses& truth, double max_distance) {
+  int count = 0;
+  const int n = static_cast<int>(truth.size());
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 2; j < n; ++j) {
+      if ((truth[i].t - truth[j].t).norm() <= max_distance + 1e-9) ++count;
+    }
+  }
+  return count;
+}
+
+TEST(GenerateCube, LoopClosureRadiusSelectsPairsWithinRadius) {
+  // pLC = 1 takes every candidate: exactly the non-consecutive pairs within
+  // radius * spacing, each once, oriented from the earlier pose. Radii
+  // given to a few digits (1.732) select the same offsets as sqrt(3).
+  for (int d : {2, 3}) {
+    for (double radius :
+         {1.0, 1.2, std::sqrt(2.0), 1.414, std::sqrt(3.0), 1.732, 2.0, 2.5}) {
+      SCOPED_TRACE(::testing::Message() << "d=" << d << " r=" << radius);
+      CubeOptions options;
+      options.dimension = d;
+      options.side = 5;
+      options.spacing = 0.5;
+      options.loop_closure_probability = 1;
+      options.loop_closure_radius = radius;
+      Poses truth;
+      const PoseGraph graph = Generate(options, &truth);
+      const int n = graph.num_poses;
+      // The squared lattice distances are integers: round the radius the
+      // way the generator documents (|o|^2 <= r^2 + 1e-3).
+      const double lattice_radius = std::sqrt(radius * radius + 1e-3);
+      const int expected = CountPairsWithin(truth, lattice_radius * 0.5);
+      EXPECT_EQ(static_cast<int>(graph.measurements.size()) - (n - 1),
+                expected);
+      std::set<std::pair<int, int>> pairs;
+      for (const RelativePoseMeasurement& e : graph.measurements) {
+        EXPECT_LT(e.i, e.j);
+        EXPECT_TRUE(pairs.insert({e.i, e.j}).second) << e.i << " " << e.j;
+        EXPECT_LE((truth[e.i].t - truth[e.j].t).norm(),
+                  lattice_radius * 0.5 + 1e-9);
+      }
+    }
+  }
+  // Known counts on a side-4 cube: lattice neighbours 3 * 16 * 3 = 144, face
+  // diagonals 3 * 2 * 4 * 9 = 216, body diagonals 4 * 27 = 108; minus the 63
+  // consecutive pairs.
+  CubeOptions options;
+  options.side = 4;
+  options.loop_closure_probability = 1;
+  const int n = 64;
+  for (const auto& [radius, candidates] :
+       std::vector<std::pair<double, int>>{{1.0, 144 - 63},
+                                           {std::sqrt(2.0), 144 + 216 - 63},
+                                           {1.732, 144 + 216 + 108 - 63}}) {
+    options.loop_closure_radius = radius;
+    EXPECT_EQ(static_cast<int>(Generate(options, nullptr).measurements.size()),
+              n - 1 + candidates)
+        << radius;
+  }
+}
+
+TEST(GenerateCube, DefaultRadiusKeepsTheRandomStream) {
+  // Radii below sqrt(2) select the unit offsets only and must reproduce the
+  // radius-1 graph bit for bit (the generator's stream before the option
+  // existed). At pLC = 1, sqrt(2) must give a strict superset of the pairs.
+  for (int d : {2, 3}) {
+    CubeOptions options;
+    options.dimension = d;
+    options.side = 5;
+    options.loop_closure_probability = 0.3;
+    options.seed = 7;
+    const PoseGraph a = Generate(options, nullptr);
+    options.loop_closure_radius = 1.41;
+    const PoseGraph b = Generate(options, nullptr);
+    ASSERT_EQ(a.measurements.size(), b.measurements.size());
+    for (size_t k = 0; k < a.measurements.size(); ++k) {
+      EXPECT_EQ(a.measurements[k].i, b.measurements[k].i);
+      EXPECT_EQ(a.measurements[k].j, b.measurements[k].j);
+      EXPECT_EQ(a.measurements[k].R, b.measurements[k].R);  // bitwise
+      EXPECT_EQ(a.measurements[k].t, b.measurements[k].t);
+    }
+    options.loop_closure_probability = 1;
+    options.loop_closure_radius = 1;
+    const PoseGraph unit = Generate(options, nullptr);
+    options.loop_closure_radius = std::sqrt(2.0);
+    const PoseGraph diagonal = Generate(options, nullptr);
+    std::set<std::pair<int, int>> diagonal_pairs;
+    for (const RelativePoseMeasurement& e : diagonal.measurements) {
+      diagonal_pairs.insert({e.i, e.j});
+    }
+    for (const RelativePoseMeasurement& e : unit.measurements) {
+      EXPECT_TRUE(diagonal_pairs.count({e.i, e.j})) << e.i << " " << e.j;
+    }
+    EXPECT_GT(diagonal.measurements.size(), unit.measurements.size());
+  }
+}
+
 TEST(GenerateCube, LoopClosureCountIsBinomial) {
   // The number of loop closures is Binomial(N, pLC) with N the candidate
   // count; accept within 5 standard deviations (per seed and in total).
@@ -257,6 +357,53 @@ TEST(GenerateCube, GroundTruthObjectiveMatchesExpectation) {
   EXPECT_NEAR(ExpectedGroundTruthObjective(3, 1, 16.67), 4.0, 0.05);
 }
 
+TEST(GenerateCube, PaperDefaultsGiveTheStatedRmsErrors) {
+  // Section 6.1: kappa = 16.67 "corresponds to an expected angular RMS error
+  // of 10 deg" (eq. 63) and tau = 75 to "an expected RMS error of 0.20 m"
+  // (sqrt(d / tau) in 3D). Measured on the generated measurements against
+  // the ground truth: mean squared angle and mean squared translation error
+  // within 5 standard errors of 10 deg^2 and 0.2^2 (pooled over seeds).
+  for (int d : {2, 3}) {
+    std::vector<double> angle2, translation2;
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+      CubeOptions options;  // kappa 16.67, tau 75, pLC 0.1
+      options.dimension = d;
+      options.side = d == 3 ? 10 : 30;
+      options.seed = seed;
+      Poses truth;
+      const PoseGraph graph = Generate(options, &truth);
+      for (const RelativePoseMeasurement& e : graph.measurements) {
+        const Eigen::MatrixXd noise =
+            (truth[e.i].R.transpose() * truth[e.j].R).transpose() * e.R;
+        const double c = std::clamp((noise.trace() - (d - 2)) / 2, -1.0, 1.0);
+        const double angle = std::acos(c);
+        angle2.push_back(angle * angle);
+        translation2.push_back(
+            (e.t - truth[e.i].R.transpose() * (truth[e.j].t - truth[e.i].t))
+                .squaredNorm());
+      }
+    }
+    auto expect_mean = [](const std::vector<double>& x, double expected,
+                          const char* what) {
+      double sum = 0, sum2 = 0;
+      for (double v : x) sum += v;
+      const double mean = sum / x.size();
+      for (double v : x) sum2 += (v - mean) * (v - mean);
+      const double se = std::sqrt(sum2 / (x.size() - 1) / x.size());
+      EXPECT_LE(std::abs(mean - expected), 5 * se)
+          << what << ": mean " << mean << " expected " << expected;
+    };
+    SCOPED_TRACE(d);
+    const double rms_angle = LangevinAngularStandardDeviation(16.67);
+    EXPECT_NEAR(rms_angle * 180 / 3.14159265358979323846, 10.0, 0.01);
+    expect_mean(angle2, rms_angle * rms_angle, "squared angle");
+    expect_mean(translation2, d / 75.0, "squared translation error");
+    if (d == 3) {
+      EXPECT_NEAR(std::sqrt(d / 75.0), 0.2, 1e-12);
+    }
+  }
+}
+
 TEST(GenerateCube, RejectsInvalidOptions) {
   auto expect_error = [](const CubeOptions& options) {
     PoseGraph graph;
@@ -289,6 +436,11 @@ TEST(GenerateCube, RejectsInvalidOptions) {
   o = CubeOptions();
   o.spacing = -1;
   expect_error(o);
+  for (double radius : {0.0, 0.99, 4.5, double(NAN), double(INFINITY)}) {
+    o = CubeOptions();
+    o.loop_closure_radius = radius;
+    expect_error(o);
+  }
 }
 
 // Runs the tool with `arguments`; returns its exit code.

@@ -16,6 +16,10 @@ DEFINE_int32(dimension, 3,
 DEFINE_double(loop_closure_probability, 0.1,
               "generate: probability pLC of a loop closure between each pair "
               "of nearby non-sequential poses.");
+DEFINE_double(loop_closure_radius, 1.0,
+              "generate: loop-closure candidates are non-consecutive poses "
+              "at most this many lattice units apart, in [1, 4] (1: lattice "
+              "neighbours; sqrt(3): the 3 x 3 x 3 block).");
 DEFINE_double(kappa, 16.67,
               "generate: rotational concentration of every measurement "
               "(16.67 ~ 10 deg RMS).");
@@ -37,8 +41,8 @@ namespace {
 
 constexpr char kUsage[] =
     "usage: ceres_sesync generate cube --side S [--dimension 2|3] "
-    "[--loop_closure_probability P] [--kappa K] [--tau T] [--seed N] "
-    "--output FILE.g2o [--ground_truth FILE.g2o] "
+    "[--loop_closure_probability P] [--loop_closure_radius R] [--kappa K] "
+    "[--tau T] [--seed N] --output FILE.g2o [--ground_truth FILE.g2o] "
     "[--vertices odometry|ground_truth|none]\n";
 
 int UsageError(const std::string& message) {
@@ -78,6 +82,7 @@ int RunGenerate(const Args& args) {
   options.dimension = FLAGS_dimension;
   options.side = FLAGS_side;
   options.loop_closure_probability = FLAGS_loop_closure_probability;
+  options.loop_closure_radius = FLAGS_loop_closure_radius;
   options.kappa = FLAGS_kappa;
   options.tau = FLAGS_tau;
   options.seed = FLAGS_seed;
