@@ -3,6 +3,8 @@
 //
 //   cube_sweep [--quick] [--realizations N] [--out_dir DIR]
 //              [--scaling_sides 5,8,...] [--scaling_time_limit S]
+//              [--loop_closure_radius R] [--sweeps kappa,tau,pLC,s]
+//              [--rms_angles 0.05,0.1,...] [--sesync_only]
 //
 // Sweeps one parameter at a time around the paper's defaults (kappa = 16.67,
 // i.e. ~10 deg RMS rotation error; tau = 75, i.e. 0.2 m RMS translation
@@ -13,7 +15,10 @@
 //  - s in 5 .. 20 (n up to 8000);
 // with N realizations (seeds 1..N) per setting, each solved by SE-Sync
 // (default options, chordal initialization), Ceres PDL-GN and LM from the
-// chordal initialization, and PDL-GN from odometry. Every run is timed from
+// chordal initialization, and PDL-GN from odometry (--sesync_only: SE-Sync
+// alone, for exactness studies). --loop_closure_radius sets the cube's
+// loop-closure neighbourhood (CubeOptions::loop_closure_radius; 1 = lattice
+// neighbours, sqrt(3) = the 3 x 3 x 3 block). Every run is timed from
 // the generated graph (initializations included). For each realization,
 // SE-Sync's certified lower bound LB also bounds every other method's
 // suboptimality: gap = (F - LB) / LB.
@@ -33,6 +38,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -58,6 +64,17 @@ DEFINE_double(scaling_time_limit, 180,
               "of its runs took longer than this many seconds.");
 DEFINE_double(ceres_max_time, 120, "Wall-clock limit of each Ceres solve.");
 DEFINE_bool(skip_sweeps, false, "Only the scaling run.");
+DEFINE_string(sweeps, "kappa,tau,pLC,s",
+              "Sweeps to run (comma-separated subset of kappa,tau,pLC,s).");
+DEFINE_string(rms_angles, "",
+              "RMS rotation errors of the kappa sweep, radians, comma-"
+              "separated (empty: 0.05,0.1,0.15,0.2,0.25,0.3,0.35,0.4,0.5).");
+DEFINE_double(loop_closure_radius, 1.0,
+              "Loop-closure candidates: non-consecutive poses at most this "
+              "many lattice units apart (1: lattice neighbours; 1.732: the "
+              "3 x 3 x 3 block). See CubeOptions::loop_closure_radius.");
+DEFINE_bool(sesync_only, false,
+            "Run only SE-Sync (no Ceres baselines): exactness studies.");
 
 namespace ceres_sesync {
 namespace {
@@ -116,10 +133,15 @@ const char* XLabel(const std::string& sweep) {
   return "side";
 }
 
-const std::vector<std::string>& Methods() {
+const std::vector<std::string>& AllMethods() {
   static const std::vector<std::string> methods = {
       "SE-Sync", "PDL-GN/chordal", "LM/chordal", "PDL-GN/odometry"};
   return methods;
+}
+
+std::vector<std::string> Methods() {
+  if (FLAGS_sesync_only) return {"SE-Sync"};
+  return AllMethods();
 }
 
 // Runs `methods` on one generated cube; appends to `runs`.
@@ -201,6 +223,16 @@ void RunCube(const std::string& sweep, double x, const CubeOptions& cube,
   std::fputc('\n', stderr);
 }
 
+std::vector<double> ParseDoubles(const std::string& s) {
+  std::vector<double> out;
+  std::stringstream in(s);
+  std::string token;
+  while (std::getline(in, token, ',')) {
+    if (!token.empty()) out.push_back(std::stod(token));
+  }
+  return out;
+}
+
 std::vector<int> ParseInts(const std::string& s) {
   std::vector<int> out;
   std::stringstream in(s);
@@ -220,14 +252,15 @@ std::string Fmt(const char* format, double v) {
 
 void WriteRuns(const std::string& path, const std::vector<Run>& runs) {
   std::ofstream out(path);
-  out << "sweep,x,kappa,tau,pLC,side,n,m,realization,method,objective,"
+  out << "sweep,x,kappa,tau,pLC,radius,side,n,m,realization,method,objective,"
          "time_s,sdp_certified,certified,rel_subopt_bound,gap_to_sesync_lb,"
          "iterations,"
          "status\n";
   for (const Run& r : runs) {
     out << r.sweep << "," << r.x << "," << r.cube.kappa << "," << r.cube.tau
-        << "," << r.cube.loop_closure_probability << "," << r.cube.side << ","
-        << r.n << "," << r.m << "," << r.realization << "," << r.method << ","
+        << "," << r.cube.loop_closure_probability << ","
+        << r.cube.loop_closure_radius << "," << r.cube.side << "," << r.n << ","
+        << r.m << "," << r.realization << "," << r.method << ","
         << Fmt("%.10g", r.objective) << "," << Fmt("%.6g", r.time_s) << ","
         << (r.method == "SE-Sync" ? (r.sdp_certified ? "1" : "0") : "") << ","
         << (r.method == "SE-Sync" ? (r.certified ? "1" : "0") : "") << ","
@@ -251,7 +284,24 @@ int main(int argc, char** argv) {
     FLAGS_minloglevel = google::GLOG_WARNING;
   }
 
-  const CubeOptions defaults;  // kappa 16.67, tau 75, pLC 0.1, s 10.
+  CubeOptions defaults;  // kappa 16.67, tau 75, pLC 0.1, s 10.
+  defaults.loop_closure_radius = FLAGS_loop_closure_radius;
+  {
+    // Validate the radius (and the rest of the defaults) once, up front.
+    std::string error;
+    CubeOptions probe = defaults;
+    probe.side = 2;
+    if (!GenerateCube(probe, nullptr, nullptr, &error)) {
+      LOG(FATAL) << "invalid cube options: " << error;
+    }
+  }
+  std::set<std::string> sweeps;
+  for (const char* name : {"kappa", "tau", "pLC", "s"}) {
+    if (("," + FLAGS_sweeps + ",").find(std::string(",") + name + ",") !=
+        std::string::npos) {
+      sweeps.insert(name);
+    }
+  }
   int realizations = std::max(1, FLAGS_realizations);
   std::vector<double> rms_angles = {0.05, 0.1,  0.15, 0.2, 0.25,
                                     0.3,  0.35, 0.4,  0.5};
@@ -259,10 +309,11 @@ int main(int argc, char** argv) {
   std::vector<double> loop_closures = {0.05, 0.1, 0.2, 0.4, 0.6, 0.8, 1.0};
   std::vector<int> sides = {5, 8, 10, 12, 15, 20};
   std::vector<int> scaling_sides = ParseInts(FLAGS_scaling_sides);
+  if (!FLAGS_rms_angles.empty()) rms_angles = ParseDoubles(FLAGS_rms_angles);
   int sweep_side = defaults.side;
   if (FLAGS_quick) {
     realizations = 1;
-    rms_angles = {0.1, 0.3, 0.5};
+    if (FLAGS_rms_angles.empty()) rms_angles = {0.1, 0.3, 0.5};
     rms_translations = {0.1, 0.3};
     loop_closures = {0.1, 0.5};
     sides = {3, 4, 5};
@@ -278,22 +329,25 @@ int main(int argc, char** argv) {
       CubeOptions base = defaults;
       base.side = sweep_side;
       base.seed = k;
-      for (double rms : rms_angles) {
+      for (double rms :
+           sweeps.count("kappa") ? rms_angles : std::vector<double>()) {
         CubeOptions c = base;
         c.kappa = KappaForRmsAngle(rms);
         RunCube("kappa", rms, c, k, Methods(), &runs);
       }
-      for (double rms : rms_translations) {
+      for (double rms :
+           sweeps.count("tau") ? rms_translations : std::vector<double>()) {
         CubeOptions c = base;
         c.tau = c.dimension / (rms * rms);
         RunCube("tau", rms, c, k, Methods(), &runs);
       }
-      for (double p : loop_closures) {
+      for (double p :
+           sweeps.count("pLC") ? loop_closures : std::vector<double>()) {
         CubeOptions c = base;
         c.loop_closure_probability = p;
         RunCube("pLC", p, c, k, Methods(), &runs);
       }
-      for (int s : sides) {
+      for (int s : sweeps.count("s") ? sides : std::vector<int>()) {
         CubeOptions c = base;
         c.side = s;
         RunCube("s", s, c, k, Methods(), &runs);
@@ -307,7 +361,9 @@ int main(int argc, char** argv) {
   for (int s : scaling_sides) {
     std::vector<std::string> methods;
     for (const char* m : {"SE-Sync", "PDL-GN/chordal"}) {
-      if (!dropped[m]) methods.push_back(m);
+      if (!dropped[m] && (!FLAGS_sesync_only || std::string(m) == "SE-Sync")) {
+        methods.push_back(m);
+      }
     }
     if (methods.empty()) break;
     CubeOptions c = defaults;
@@ -366,7 +422,7 @@ int main(int argc, char** argv) {
   // Sweeps in the order run, then by x, then methods in Methods() order.
   std::map<std::string, int> sweep_rank, method_rank;
   for (const Key& key : order) sweep_rank.emplace(key.sweep, sweep_rank.size());
-  for (const std::string& m : Methods())
+  for (const std::string& m : AllMethods())
     method_rank.emplace(m, method_rank.size());
   std::sort(order.begin(), order.end(), [&](const Key& a, const Key& b) {
     return std::make_tuple(sweep_rank[a.sweep], a.x, method_rank[a.method]) <
@@ -393,18 +449,23 @@ int main(int argc, char** argv) {
        << " | " << Fmt("%.1e", Median(a.gap)) << " | " << Fmt("%.1e", max_gap)
        << " |\n";
   }
-  md << "\nScaling (one realization, kappa 16.67, tau 75, pLC 0.1):\n\n"
+  md << "\nScaling (one realization, kappa 16.67, tau 75, pLC 0.1, "
+        "loop-closure radius "
+     << defaults.loop_closure_radius
+     << "):\n\n"
         "| s | n | m | method | time [s] | F | certified (MLE) | rel. bound |\n"
         "|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : scaling) {
     md << "| " << r.cube.side << " | " << r.n << " | " << r.m << " | "
        << r.method << " | " << Fmt("%.4f", r.time_s) << " | "
        << Fmt("%.6g", r.objective) << " | "
-       << (r.method == "SE-Sync" ? (r.certified ? "yes" : "no") : "") << " |\n";
+       << (r.method == "SE-Sync" ? (r.certified ? "yes" : "no") : "") << " | "
+       << (r.method == "SE-Sync" ? Fmt("%.1e", r.rel_bound) : "") << " |\n";
   }
   md << "\nRealizations per setting: " << realizations << "; sweeps at side "
      << sweep_side << " (n = " << sweep_side * sweep_side * sweep_side
-     << ") unless swept. Certified = SE-Sync certified the SDP solution AND "
+     << ") unless swept; loop-closure radius " << defaults.loop_closure_radius
+     << " lattice units. Certified = SE-Sync certified the SDP solution AND "
         "its "
         "rounded poses are within 1e-6 relative of the lower bound. Gap to LB "
         "= (F - LB) / LB with LB the lower bound "
