@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "ceres_sesync/internal/certificate_matrix.h"
+#include "ceres_sesync/internal/parallel.h"
 #include "ceres_sesync/internal/rounding.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/internal/verification.h"
@@ -56,7 +57,8 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
   if (n == 1) {  // No measurements: the single pose is trivially optimal.
     c.certified = true;
   } else {
-    const internal::SESyncProblem problem(graph);
+    const internal::SESyncProblem problem(
+        graph, internal::ResolveNumThreads(options.num_threads));
     if (!problem.ok()) return fail("the translational Laplacian is singular");
     Eigen::MatrixXd RQ;
     problem.MultiplyQ(R, &RQ);

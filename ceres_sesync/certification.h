@@ -64,6 +64,9 @@ struct CertifyOptions {
   bool improve_if_not_certified = false;
   // Options for that improvement run.
   SolverOptions solver_options;
+  // Threads for the products with Q (<= 0: all cores); see
+  // SolverOptions::num_threads.
+  int num_threads = 0;
 };
 
 struct Certificate {

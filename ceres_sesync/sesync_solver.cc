@@ -10,6 +10,7 @@
 #include "ceres_sesync/internal/ceres_local_solver.h"
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/chordal.h"
+#include "ceres_sesync/internal/parallel.h"
 #include "ceres_sesync/internal/rounding.h"
 #include "ceres_sesync/internal/sesync_cost.h"
 #include "ceres_sesync/internal/sesync_problem.h"
@@ -104,7 +105,8 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
 
   // Data matrices.
   auto t = Clock::now();
-  internal::SESyncProblem problem(graph);
+  internal::SESyncProblem problem(
+      graph, internal::ResolveNumThreads(options.num_threads));
   if (!problem.ok()) {
     s.status = SolverSummary::Status::kInvalidInput;
     s.message = "the translational Laplacian is not positive definite";

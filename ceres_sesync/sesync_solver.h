@@ -110,6 +110,13 @@ struct SolverOptions {
   // lowers F(x) (and the suboptimality bound).
   bool refine_rounded_solution = true;
 
+  // Threads for the O(m r) kernels (products with Q, the preconditioner's
+  // triangular solves, one thread per row block of Y). <= 0: all cores
+  // (std::thread::hardware_concurrency()). Results do not depend on it. Needs
+  // a build with OpenMP (else serial); the sparse factorizations themselves
+  // (CHOLMOD) are serial in the Debian build.
+  int num_threads = 0;
+
   // Wall-clock limit for the whole solve (<= 0: none).
   double max_time_s = 0;
   // Log progress (rank, iteration, F, gradient norm, trust radius) via glog.

@@ -103,6 +103,27 @@ TEST(ConfigureCholmod, EveryLayoutRejectsIndefiniteMatrices) {
   }
 }
 
+// Rows are split over threads with unchanged arithmetic: bitwise identical
+// results (the matrix is large enough to pass the parallel work threshold).
+TEST(SparseCholeskyFactor, ThreadsGiveIdenticalResults) {
+  const int n = 4000;
+  const SparseMatrix A = RandomSpd(n, 8000, 3);
+  CholmodFactor factor;
+  ConfigureCholmod(CholmodLayout::kAutomatic, &factor);
+  factor.compute(A);
+  ASSERT_EQ(factor.info(), Eigen::Success);
+  const SparseCholeskyFactor solver = factor.ExtractFactor();
+  for (int r : {2, 5, 7}) {
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(r, n - 10);
+    Eigen::MatrixXd serial, parallel;
+    solver.SolveRowsTail(B, 10, &serial, 1);
+    for (int threads : {2, 3, 16}) {
+      solver.SolveRowsTail(B, 10, &parallel, threads);
+      EXPECT_TRUE(parallel == serial) << "r " << r << " threads " << threads;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(AllKernels, SparseCholeskyFactorTest,
                          ::testing::Combine(::testing::Bool(),
                                             ::testing::Range(1, 9)));

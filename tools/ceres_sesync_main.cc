@@ -11,6 +11,8 @@
 DEFINE_string(json, "", "Write a machine-readable JSON summary to this path.");
 DEFINE_string(output, "", "Write the resulting poses (g2o) to this path.");
 DEFINE_bool(verbose, false, "Log solver progress to stderr.");
+DEFINE_int32(num_threads, 0,
+             "solve, certify: threads for the O(m r) kernels (0: all cores).");
 
 namespace {
 

@@ -41,6 +41,8 @@ int RunCertify(const Args& args) {
   CertifyOptions options;
   options.max_relative_suboptimality = FLAGS_max_relative_suboptimality;
   options.improve_if_not_certified = FLAGS_improve;
+  options.num_threads = FLAGS_num_threads;
+  options.solver_options.num_threads = FLAGS_num_threads;
   Certificate certificate;
   if (!Certify(graph, poses, options, &certificate, &error)) {
     std::fprintf(stderr, "ceres_sesync certify: %s: %s\n", args[1].c_str(),

@@ -17,6 +17,7 @@
 DECLARE_string(json);
 DECLARE_string(output);
 DECLARE_bool(verbose);
+DECLARE_int32(num_threads);
 
 namespace ceres_sesync::tools {
 

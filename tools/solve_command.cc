@@ -76,6 +76,7 @@ int RunSolve(const Args& args) {
   options.max_rank = FLAGS_max_rank;
   options.max_time_s = FLAGS_max_time;
   options.verbose = FLAGS_verbose;
+  options.num_threads = FLAGS_num_threads;
   options.relative_preconditioned_gradient_tolerance = FLAGS_gradient_tolerance;
 
   const std::string& path = args[0];

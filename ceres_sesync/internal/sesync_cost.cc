@@ -14,7 +14,9 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
                                            PreconditionerType type,
                                            double max_condition,
                                            CertificateMatrix* workspace)
-    : d_(problem.dimension()), type_(type) {
+    : d_(problem.dimension()),
+      num_threads_(problem.num_threads()),
+      type_(type) {
   if (type == PreconditionerType::kNone) return;
   const SparseMatrix& D = problem.D();
   // Gershgorin bound on lambda_max(D).
@@ -71,10 +73,10 @@ void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
       BlockDiagonalMultiply(V, block_inverses_, d_, X);
       return;
     case PreconditionerType::kSparseCholesky:
-      factor_.SolveRows(V, X);
+      factor_.SolveRows(V, X, num_threads_);
       return;
     case PreconditionerType::kRegularizedQ:
-      factor_.SolveRowsTail(V, translation_size_, X);
+      factor_.SolveRowsTail(V, translation_size_, X, num_threads_);
       return;
   }
 }

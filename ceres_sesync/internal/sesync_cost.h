@@ -37,6 +37,7 @@ class SESyncPreconditioner {
 
  private:
   int d_;
+  int num_threads_;
   PreconditionerType type_;
   Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.
   // D + eps I (kSparseCholesky) or K_eps (kRegularizedQ, whose first

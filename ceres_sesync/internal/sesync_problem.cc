@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "ceres_sesync/internal/parallel.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
@@ -19,7 +20,8 @@ namespace {
 // the small r of the staircase.
 template <int R>
 void MultiplyBySparseKernel(const Eigen::MatrixXd& Y, const SparseMatrix& A,
-                            bool accumulate, Eigen::MatrixXd* out) {
+                            bool accumulate, int begin, int end,
+                            Eigen::MatrixXd* out) {
   using Vector = Eigen::Matrix<double, R, 1>;
   using ConstMap = Eigen::Map<const Vector>;
   const int r = static_cast<int>(Y.rows());
@@ -28,7 +30,7 @@ void MultiplyBySparseKernel(const Eigen::MatrixXd& Y, const SparseMatrix& A,
   const double* value = A.valuePtr();
   const double* y = Y.data();
   Vector sum(r);
-  for (int j = 0; j < A.cols(); ++j) {
+  for (int j = begin; j < end; ++j) {
     sum.setZero();
     for (int k = start[j]; k < start[j + 1]; ++k) {
       sum +=
@@ -44,22 +46,31 @@ void MultiplyBySparseKernel(const Eigen::MatrixXd& Y, const SparseMatrix& A,
   }
 }
 
+// Output columns are split into contiguous ranges, one per thread.
 void MultiplyBySparse(const Eigen::MatrixXd& Y, const SparseMatrix& A,
-                      bool accumulate, Eigen::MatrixXd* out) {
+                      bool accumulate, int num_threads, Eigen::MatrixXd* out) {
   DCHECK(A.isCompressed());
   if (!accumulate) out->resize(Y.rows(), A.cols());
-  switch (Y.rows()) {
-    case 3:
-      return MultiplyBySparseKernel<3>(Y, A, accumulate, out);
-    case 4:
-      return MultiplyBySparseKernel<4>(Y, A, accumulate, out);
-    case 5:
-      return MultiplyBySparseKernel<5>(Y, A, accumulate, out);
-    case 6:
-      return MultiplyBySparseKernel<6>(Y, A, accumulate, out);
-    default:
-      return MultiplyBySparseKernel<Eigen::Dynamic>(Y, A, accumulate, out);
-  }
+  const int cols = static_cast<int>(A.cols());
+  const int parts =
+      ThreadsFor(num_threads, 2.0 * Y.rows() * (A.nonZeros() + cols));
+  ParallelParts(parts, [&](int part, int num_parts) {
+    const int begin = PartBegin(cols, part, num_parts);
+    const int end = PartBegin(cols, part + 1, num_parts);
+    switch (Y.rows()) {
+      case 3:
+        return MultiplyBySparseKernel<3>(Y, A, accumulate, begin, end, out);
+      case 4:
+        return MultiplyBySparseKernel<4>(Y, A, accumulate, begin, end, out);
+      case 5:
+        return MultiplyBySparseKernel<5>(Y, A, accumulate, begin, end, out);
+      case 6:
+        return MultiplyBySparseKernel<6>(Y, A, accumulate, begin, end, out);
+      default:
+        return MultiplyBySparseKernel<Eigen::Dynamic>(Y, A, accumulate, begin,
+                                                      end, out);
+    }
+  });
 }
 
 }  // namespace
@@ -115,8 +126,10 @@ void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
   common.print = 0;
 }
 
-SESyncProblem::SESyncProblem(const PoseGraph& graph)
-    : d_(graph.dimension), n_(graph.num_poses) {
+SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
+    : d_(graph.dimension),
+      n_(graph.num_poses),
+      num_threads_(std::max(1, num_threads)) {
   const int d = d_, n = n_;
   std::vector<Triplet> lrho, sigma, v, lw;
   const size_t m = graph.measurements.size();
@@ -182,12 +195,12 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph)
 
 void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,
                               Eigen::MatrixXd* YQ) const {
-  MultiplyBySparse(Y, D_, /*accumulate=*/false, YQ);
+  MultiplyBySparse(Y, D_, /*accumulate=*/false, num_threads_, YQ);
   if (n_ == 1) return;
   Eigen::MatrixXd P, Z;  // P = Y Vbar^T (r x (n-1)), Z = P Lbar^{-1}.
-  MultiplyBySparse(Y, VbarT_, /*accumulate=*/false, &P);
-  lbar_solver_.SolveRows(P, &Z);
-  MultiplyBySparse(Z, minus_Vbar_, /*accumulate=*/true, YQ);
+  MultiplyBySparse(Y, VbarT_, /*accumulate=*/false, num_threads_, &P);
+  lbar_solver_.SolveRows(P, &Z, num_threads_);
+  MultiplyBySparse(Z, minus_Vbar_, /*accumulate=*/true, num_threads_, YQ);
 }
 
 Eigen::MatrixXd SESyncProblem::RecoverTranslations(

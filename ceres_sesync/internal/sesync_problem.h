@@ -63,12 +63,14 @@ void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor);
 class SESyncProblem {
  public:
   // `graph` must pass ValidatePoseGraph. Check ok() afterwards: it fails only
-  // if the translational Laplacian could not be factorized.
-  explicit SESyncProblem(const PoseGraph& graph);
+  // if the translational Laplacian could not be factorized. Products with Q
+  // use up to `num_threads` threads (results do not depend on it).
+  explicit SESyncProblem(const PoseGraph& graph, int num_threads = 1);
 
   bool ok() const { return ok_; }
   int dimension() const { return d_; }
   int num_poses() const { return n_; }
+  int num_threads() const { return num_threads_; }
 
   // YQ = Y * Q for Y of size r x dn. O(m r) plus one Cholesky solve.
   void MultiplyQ(const Eigen::MatrixXd& Y, Eigen::MatrixXd* YQ) const;
@@ -87,7 +89,7 @@ class SESyncProblem {
   const SparseMatrix& RotationLaplacian() const { return Lrho_; }
 
  private:
-  int d_ = 0, n_ = 0;
+  int d_ = 0, n_ = 0, num_threads_ = 1;
   bool ok_ = false;
   SparseMatrix D_, Lrho_, Vbar_, VbarT_, minus_Vbar_, Lbar_;
   std::unique_ptr<CholmodFactor> lbar_factor_;

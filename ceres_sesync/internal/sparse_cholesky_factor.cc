@@ -1,5 +1,8 @@
 #include "ceres_sesync/internal/sparse_cholesky_factor.h"
 
+#include <algorithm>
+
+#include "ceres_sesync/internal/parallel.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
@@ -86,30 +89,39 @@ void SparseCholeskyFactor::SolvePermuted(int r, double* w) const {
 }
 
 void SparseCholeskyFactor::SolveRows(const Eigen::MatrixXd& B,
-                                     Eigen::MatrixXd* X) const {
-  SolveRowsTail(B, 0, X);
+                                     Eigen::MatrixXd* X,
+                                     int num_threads) const {
+  SolveRowsTail(B, 0, X, num_threads);
 }
 
 void SparseCholeskyFactor::SolveRowsTail(const Eigen::MatrixXd& B, int offset,
-                                         Eigen::MatrixXd* X) const {
+                                         Eigen::MatrixXd* X,
+                                         int num_threads) const {
   CHECK_EQ(offset + B.cols(), n_);
   const int r = static_cast<int>(B.rows());
-  // W = B P^T (with zero leading columns), solved, then X = W P.
-  Eigen::MatrixXd W(r, n_);
-  for (int k = 0; k < n_; ++k) {
-    const int source = permutation_[k] - offset;
-    if (source >= 0) {
-      W.col(k) = B.col(source);
-    } else {
-      W.col(k).setZero();
-    }
-  }
-  SolvePermuted(r, W.data());
   X->resize(r, B.cols());
-  for (int k = 0; k < n_; ++k) {
-    const int target = permutation_[k] - offset;
-    if (target >= 0) X->col(target) = W.col(k);
-  }
+  const double work = 4.0 * r * (values_.size() + n_);
+  const int parts = std::min(r, ThreadsFor(num_threads, work));
+  // Each part solves its own rows in a private contiguous workspace:
+  // W = B P^T (with zero leading columns), solved, then X = W P.
+  ParallelParts(parts, [&](int part, int num_parts) {
+    const int row = PartBegin(r, part, num_parts);
+    const int rows = PartBegin(r, part + 1, num_parts) - row;
+    Eigen::MatrixXd W(rows, n_);
+    for (int k = 0; k < n_; ++k) {
+      const int source = permutation_[k] - offset;
+      if (source >= 0) {
+        W.col(k) = B.col(source).segment(row, rows);
+      } else {
+        W.col(k).setZero();
+      }
+    }
+    SolvePermuted(rows, W.data());
+    for (int k = 0; k < n_; ++k) {
+      const int target = permutation_[k] - offset;
+      if (target >= 0) X->col(target).segment(row, rows) = W.col(k);
+    }
+  });
 }
 
 }  // namespace ceres_sesync::internal

@@ -23,13 +23,15 @@ class SparseCholeskyFactor {
   SparseCholeskyFactor(const cholmod_factor* factor, cholmod_common* common);
 
   int size() const { return n_; }
-  // X = B A^{-1} for B of size r x size(); X may not alias B.
-  void SolveRows(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const;
+  // X = B A^{-1} for B of size r x size(); X may not alias B. The r rows are
+  // independent solves, split over up to `num_threads` threads.
+  void SolveRows(const Eigen::MatrixXd& B, Eigen::MatrixXd* X,
+                 int num_threads = 1) const;
   // The same for an A of size offset + B.cols() and a right-hand side that is
   // zero in its first `offset` columns; returns only the last B.cols()
   // columns of the solution (the rotation block of an augmented system).
-  void SolveRowsTail(const Eigen::MatrixXd& B, int offset,
-                     Eigen::MatrixXd* X) const;
+  void SolveRowsTail(const Eigen::MatrixXd& B, int offset, Eigen::MatrixXd* X,
+                     int num_threads = 1) const;
 
  private:
   // W = W L^{-T} L^{-1} for W (r x size(), column-major), in place.
