@@ -69,22 +69,24 @@ bool ValidatePoseGraph(const PoseGraph& graph, std::string* error) {
   }
   for (size_t k = 0; k < graph.measurements.size(); ++k) {
     const auto& e = graph.measurements[k];
-    std::ostringstream where;
-    where << "measurement " << k << " (" << e.i << " -> " << e.j << "): ";
+    auto where = [&] {
+      return "measurement " + std::to_string(k) + " (" + std::to_string(e.i) +
+             " -> " + std::to_string(e.j) + "): ";
+    };
     if (e.i < 0 || e.j < 0 || e.i >= graph.num_poses ||
         e.j >= graph.num_poses) {
-      return fail(where.str() + "pose index out of range");
+      return fail(where() + "pose index out of range");
     }
-    if (e.i == e.j) return fail(where.str() + "self-loop");
+    if (e.i == e.j) return fail(where() + "self-loop");
     if (!IsRotation(e.R, d, 1e-6)) {
-      return fail(where.str() + "rotation is not in SO(d)");
+      return fail(where() + "rotation is not in SO(d)");
     }
     if (e.t.size() != d || !e.t.allFinite()) {
-      return fail(where.str() + "translation is not a finite d-vector");
+      return fail(where() + "translation is not a finite d-vector");
     }
     if (!(std::isfinite(e.kappa) && e.kappa > 0 && std::isfinite(e.tau) &&
           e.tau > 0)) {
-      return fail(where.str() + "kappa and tau must be finite and positive");
+      return fail(where() + "kappa and tau must be finite and positive");
     }
   }
   if (graph.fixed_pose < -1 || graph.fixed_pose >= graph.num_poses) {

@@ -58,6 +58,8 @@ void MultiplyBySparse(const Eigen::MatrixXd& Y, const SparseMatrix& A,
     const int begin = PartBegin(cols, part, num_parts);
     const int end = PartBegin(cols, part + 1, num_parts);
     switch (Y.rows()) {
+      case 2:
+        return MultiplyBySparseKernel<2>(Y, A, accumulate, begin, end, out);
       case 3:
         return MultiplyBySparseKernel<3>(Y, A, accumulate, begin, end, out);
       case 4:
@@ -113,6 +115,35 @@ double CholmodFactor::BackwardErrorBound() {
 
 SparseCholeskyFactor CholmodFactor::ExtractFactor() {
   return SparseCholeskyFactor(m_cholmodFactor, &cholmod());
+}
+
+void CholmodFactor::AnalyzePatternWithOrdering(const SparseMatrix& lower,
+                                               std::vector<int> ordering) {
+  CHECK_EQ(static_cast<int>(ordering.size()), lower.rows());
+  cholmod_common& common = cholmod();
+  if (m_cholmodFactor != nullptr) {
+    cholmod_free_factor(&m_cholmodFactor, &common);
+  }
+  cholmod_sparse A =
+      Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
+  const int saved_methods = common.nmethods;
+  const int saved_ordering = common.method[0].ordering;
+  common.nmethods = 1;
+  common.method[0].ordering = CHOLMOD_GIVEN;
+  m_cholmodFactor = cholmod_analyze_p(&A, ordering.data(), nullptr, 0, &common);
+  common.nmethods = saved_methods;
+  common.method[0].ordering = saved_ordering;
+  CHECK(m_cholmodFactor != nullptr) << "cholmod_analyze_p failed";
+  m_isInitialized = true;
+  m_info = Eigen::Success;
+  m_analysisIsOk = true;
+  m_factorizationIsOk = false;
+}
+
+std::vector<int> CholmodFactor::Ordering() const {
+  CHECK(m_cholmodFactor != nullptr);
+  const int* perm = static_cast<const int*>(m_cholmodFactor->Perm);
+  return std::vector<int>(perm, perm + m_cholmodFactor->n);
 }
 
 void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {

@@ -17,6 +17,7 @@
 #define CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
 
 #include <memory>
+#include <vector>
 
 #include "Eigen/CholmodSupport"
 #include "Eigen/Core"
@@ -44,6 +45,13 @@ class CholmodFactor
   // After a successful factorization: a copy of the factor for fast solves
   // with r x N right-hand sides.
   SparseCholeskyFactor ExtractFactor();
+  // analyzePattern() with a fill-reducing ordering chosen by the caller
+  // (ordering[k] = original index of the k-th pivot) instead of CHOLMOD's
+  // own (AMD, possibly METIS) on the full matrix.
+  void AnalyzePatternWithOrdering(const SparseMatrix& lower,
+                                  std::vector<int> ordering);
+  // After analyzePattern(): CHOLMOD's fill-reducing ordering.
+  std::vector<int> Ordering() const;
 };
 
 // How CHOLMOD organizes the factor. Simplicial: fast for the very sparse
