@@ -33,6 +33,40 @@ std::string ConstraintName(int index, int64_t id_begin, int64_t id_end) {
          std::to_string(id_begin) + " -> " + std::to_string(id_end) + ")";
 }
 
+// The part of MeasurementFromCeres2d/3d after their pose checks: (kappa,
+// tau) from the information matrix (the g2o reader's convention) and the
+// relative pose.
+bool FinishCeresMeasurement(const std::string& name,
+                            const Eigen::MatrixXd& information,
+                            const Pose& pose, RelativePoseMeasurement* m,
+                            std::string* error) {
+  std::string message;
+  if (!IsotropicPrecisions(information, &m->kappa, &m->tau, &message)) {
+    return internal::ConversionFail(name + ": " + message, error);
+  }
+  m->R = pose.R;
+  m->t = pose.t;
+  return true;
+}
+
+// PoseToIsometry for Eigen::Isometry2d and Eigen::Isometry3d.
+template <int kD>
+bool PoseToIsometryImpl(
+    const Pose& pose, Eigen::Transform<double, kD, Eigen::Isometry>* transform,
+    std::string* error) {
+  if (transform == nullptr) {
+    return internal::ConversionFail("PoseToIsometry: null output", error);
+  }
+  if (!internal::CheckPoseForConversion(pose, kD, "PoseToIsometry: the pose",
+                                        error)) {
+    return false;
+  }
+  transform->setIdentity();
+  transform->linear() = ProjectToRotation<kD>(pose.R);
+  transform->translation() = pose.t;
+  return true;
+}
+
 }  // namespace
 
 namespace internal {
@@ -58,8 +92,13 @@ bool CheckPoseForConversion(const Pose& pose, int d, const std::string& what,
   return true;
 }
 
-bool CheckGraphForAdapter(const PoseGraph& graph, int d, const char* adapter,
-                          std::string* error) {
+bool CheckAdapterCall(const void* output, const char* output_name,
+                      const PoseGraph& graph, int d, const char* adapter,
+                      std::string* error) {
+  if (output == nullptr) {
+    return ConversionFail(
+        std::string(adapter) + ": null " + std::string(output_name), error);
+  }
   if (graph.dimension != d) {
     return ConversionFail(std::string(adapter) + ": the pose graph is " +
                               std::to_string(graph.dimension) + "D, not " +
@@ -86,14 +125,8 @@ bool MeasurementFromCeres2d(int index, int64_t id_begin, int64_t id_end,
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(yaw_radians)) {
     return ConversionFail(name + ": non-finite relative pose", error);
   }
-  std::string message;
-  if (!IsotropicPrecisions(information, &m->kappa, &m->tau, &message)) {
-    return ConversionFail(name + ": " + message, error);
-  }
-  const Pose pose = PoseFromXYYaw(x, y, yaw_radians);
-  m->R = pose.R;
-  m->t = pose.t;
-  return true;
+  return FinishCeresMeasurement(name, information,
+                                PoseFromXYYaw(x, y, yaw_radians), m, error);
 }
 
 bool MeasurementFromCeres3d(int index, int64_t id_begin, int64_t id_end,
@@ -112,14 +145,8 @@ bool MeasurementFromCeres3d(int index, int64_t id_begin, int64_t id_end,
                               " (more than 1e-2 from unit length)",
                           error);
   }
-  std::string message;
-  if (!IsotropicPrecisions(information, &m->kappa, &m->tau, &message)) {
-    return ConversionFail(name + ": " + message, error);
-  }
-  const Pose pose = PoseFromQuaternionTranslation(q, p);
-  m->R = pose.R;
-  m->t = pose.t;
-  return true;
+  return FinishCeresMeasurement(name, information,
+                                PoseFromQuaternionTranslation(q, p), m, error);
 }
 
 bool AddCeresMeasurement(int index, int64_t id_begin, int64_t id_end,
@@ -197,32 +224,12 @@ Pose PoseFromXYYaw(double x, double y, double yaw_radians) {
 
 bool PoseToIsometry(const Pose& pose, Eigen::Isometry2d* transform,
                     std::string* error) {
-  if (transform == nullptr) {
-    return internal::ConversionFail("PoseToIsometry: null output", error);
-  }
-  if (!internal::CheckPoseForConversion(pose, 2, "PoseToIsometry: the pose",
-                                        error)) {
-    return false;
-  }
-  transform->setIdentity();
-  transform->linear() = ProjectToRotation<2>(pose.R);
-  transform->translation() = pose.t;
-  return true;
+  return PoseToIsometryImpl<2>(pose, transform, error);
 }
 
 bool PoseToIsometry(const Pose& pose, Eigen::Isometry3d* transform,
                     std::string* error) {
-  if (transform == nullptr) {
-    return internal::ConversionFail("PoseToIsometry: null output", error);
-  }
-  if (!internal::CheckPoseForConversion(pose, 3, "PoseToIsometry: the pose",
-                                        error)) {
-    return false;
-  }
-  transform->setIdentity();
-  transform->linear() = ProjectToRotation<3>(pose.R);
-  transform->translation() = pose.t;
-  return true;
+  return PoseToIsometryImpl<3>(pose, transform, error);
 }
 
 bool PoseToQuaternionTranslation(const Pose& pose, Eigen::Quaterniond* q,

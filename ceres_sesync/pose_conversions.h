@@ -240,10 +240,12 @@ bool ConversionFail(const std::string& message, std::string* error);
 bool CheckPoseForConversion(const Pose& pose, int d, const std::string& what,
                             std::string* error);
 
-// Checks graph.dimension == d and the vertex id table; `adapter` names the
-// caller in the message.
-bool CheckGraphForAdapter(const PoseGraph& graph, int d, const char* adapter,
-                          std::string* error);
+// Checks that `output` is not null (message "ADAPTER: null OUTPUT_NAME"),
+// graph.dimension == d and the vertex id table; `adapter` names the caller in
+// the messages.
+bool CheckAdapterCall(const void* output, const char* output_name,
+                      const PoseGraph& graph, int d, const char* adapter,
+                      std::string* error);
 
 // Builds the measurement of one Ceres-example constraint (number `index` in
 // the range, ids for messages).
@@ -274,12 +276,76 @@ bool VertexIdToKey(int64_t id, Key* key) {
   return static_cast<int64_t>(*key) == id;
 }
 
-// Shared loop of the map readers: `convert(value, &pose)` per vertex.
-template <typename Map, typename Convert>
-bool PosesFromCeresMap(const PoseGraph& graph, const Map& poses, int d,
-                       const char* adapter, Convert convert, Poses* out,
-                       std::string* error) {
-  if (!CheckGraphForAdapter(graph, d, adapter, error)) return false;
+// What differs between the data layouts of Ceres's pose_graph_2d and
+// pose_graph_3d examples (see the top): the pose members of a map value and
+// of a constraint, and the isotropic information matrix. Each adapter below
+// is written once, for a Layout.
+struct Ceres2dLayout {
+  static constexpr int kDimension = 2;
+
+  template <typename Value>
+  static Pose ToPose(const Value& value) {
+    return PoseFromXYYaw(value.x, value.y, value.yaw_radians);
+  }
+  template <typename Value>
+  static void FromPose(const Pose& pose, Value* value) {
+    PoseToXYYaw(pose, &value->x, &value->y, &value->yaw_radians);
+  }
+  template <typename Constraint>
+  static bool ToMeasurement(int index, int64_t id_begin, int64_t id_end,
+                            const Constraint& c, RelativePoseMeasurement* m,
+                            std::string* error) {
+    return MeasurementFromCeres2d(index, id_begin, id_end, c.x, c.y,
+                                  c.yaw_radians, c.information, m, error);
+  }
+  template <typename Constraint>
+  static void FromMeasurement(const RelativePoseMeasurement& m, Constraint* c) {
+    c->x = m.t(0);
+    c->y = m.t(1);
+    c->yaw_radians = std::atan2(m.R(1, 0), m.R(0, 0));
+    c->information =
+        Eigen::Vector3d(m.tau, m.tau, m.kappa).asDiagonal().toDenseMatrix();
+  }
+};
+
+struct Ceres3dLayout {
+  static constexpr int kDimension = 3;
+
+  template <typename Value>
+  static Pose ToPose(const Value& value) {
+    return PoseFromQuaternionTranslation(value.q, value.p);
+  }
+  template <typename Value>
+  static void FromPose(const Pose& pose, Value* value) {
+    Eigen::Quaterniond q;
+    Eigen::Vector3d t;
+    PoseToQuaternionTranslation(pose, &q, &t);
+    value->p = t;
+    value->q = q;
+  }
+  template <typename Constraint>
+  static bool ToMeasurement(int index, int64_t id_begin, int64_t id_end,
+                            const Constraint& c, RelativePoseMeasurement* m,
+                            std::string* error) {
+    return MeasurementFromCeres3d(index, id_begin, id_end, c.t_be.p, c.t_be.q,
+                                  c.information, m, error);
+  }
+  template <typename Constraint>
+  static void FromMeasurement(const RelativePoseMeasurement& m, Constraint* c) {
+    FromPose(Pose{m.R, m.t}, &c->t_be);
+    Eigen::Matrix<double, 6, 1> diagonal;
+    diagonal << m.tau, m.tau, m.tau, 2 * m.kappa, 2 * m.kappa, 2 * m.kappa;
+    c->information = diagonal.asDiagonal().toDenseMatrix();
+  }
+};
+
+// PosesFromCeres2dMap / PosesFromCeres3dMap; `adapter` names the caller in
+// messages.
+template <typename Layout, typename Map>
+bool PosesFromCeresMap(const PoseGraph& graph, const Map& poses,
+                       const char* adapter, Poses* out, std::string* error) {
+  constexpr int d = Layout::kDimension;
+  if (!CheckAdapterCall(out, "output", graph, d, adapter, error)) return false;
   Poses result(graph.num_poses);
   for (int i = 0; i < graph.num_poses; ++i) {
     const int64_t id = graph.vertex_ids[i];
@@ -291,7 +357,7 @@ bool PosesFromCeresMap(const PoseGraph& graph, const Map& poses, int d,
                                 " of the pose graph is not in the map",
                             error);
     }
-    result[i] = convert(it->second);
+    result[i] = Layout::ToPose(it->second);
     if (!CheckPoseForConversion(
             result[i], d, "pose of vertex id " + std::to_string(id), error)) {
       return false;
@@ -301,15 +367,12 @@ bool PosesFromCeresMap(const PoseGraph& graph, const Map& poses, int d,
   return true;
 }
 
-// Shared loop of the map writers: `assign(pose, &value)` per vertex.
-template <typename Map, typename Assign>
-bool PosesToCeresMap(const PoseGraph& graph, const Poses& poses, int d,
-                     const char* adapter, Assign assign, Map* map,
-                     std::string* error) {
-  if (map == nullptr) {
-    return ConversionFail(std::string(adapter) + ": null map", error);
-  }
-  if (!CheckGraphForAdapter(graph, d, adapter, error)) return false;
+// PosesToCeres2dMap / PosesToCeres3dMap.
+template <typename Layout, typename Map>
+bool PosesToCeresMap(const PoseGraph& graph, const Poses& poses,
+                     const char* adapter, Map* map, std::string* error) {
+  constexpr int d = Layout::kDimension;
+  if (!CheckAdapterCall(map, "map", graph, d, adapter, error)) return false;
   if (static_cast<int>(poses.size()) != graph.num_poses) {
     return ConversionFail(std::string(adapter) + ": " +
                               std::to_string(poses.size()) +
@@ -331,7 +394,101 @@ bool PosesToCeresMap(const PoseGraph& graph, const Poses& poses, int d,
       return false;
     }
   }
-  for (int i = 0; i < graph.num_poses; ++i) assign(poses[i], &(*map)[keys[i]]);
+  for (int i = 0; i < graph.num_poses; ++i) {
+    Layout::FromPose(poses[i], &(*map)[keys[i]]);
+  }
+  return true;
+}
+
+// Appends one measurement per constraint to `assembled` (adding their
+// vertices if `add_vertices`, else requiring them to be there), then
+// validates it and moves it into `out`.
+template <typename Layout, typename Constraints>
+bool FinishFromCeresConstraints(const Constraints& constraints,
+                                bool add_vertices, PoseGraph* assembled,
+                                PoseGraph* out, std::string* error) {
+  int index = 0;
+  for (const auto& c : constraints) {
+    const int64_t id_begin = static_cast<int64_t>(c.id_begin);
+    const int64_t id_end = static_cast<int64_t>(c.id_end);
+    RelativePoseMeasurement m;
+    if (!Layout::ToMeasurement(index, id_begin, id_end, c, &m, error) ||
+        !AddCeresMeasurement(index, id_begin, id_end, add_vertices,
+                             std::move(m), assembled, error)) {
+      return false;
+    }
+    ++index;
+  }
+  return FinishCeresPoseGraph(index, assembled, out, error);
+}
+
+// PoseGraphFromCeres2dConstraints / PoseGraphFromCeres3dConstraints.
+template <typename Layout, typename Constraints>
+bool PoseGraphFromCeresConstraints(const Constraints& constraints,
+                                   PoseGraph* graph, std::string* error) {
+  PoseGraph assembled;
+  assembled.dimension = Layout::kDimension;
+  return FinishFromCeresConstraints<Layout>(constraints, /*add_vertices=*/true,
+                                            &assembled, graph, error);
+}
+
+// PoseGraphFromCeres2d / PoseGraphFromCeres3d.
+template <typename Layout, typename Map, typename Constraints>
+bool PoseGraphFromCeresMap(const Map& poses, const Constraints& constraints,
+                           const char* adapter, PoseGraph* graph,
+                           std::string* error) {
+  PoseGraph assembled;
+  assembled.dimension = Layout::kDimension;
+  for (const auto& [id, value] : poses) {
+    const int64_t vertex_id = static_cast<int64_t>(id);
+    assembled.AddVertex(vertex_id);
+    assembled.initial_poses.push_back(Layout::ToPose(value));
+    if (!CheckPoseForConversion(assembled.initial_poses.back(),
+                                Layout::kDimension,
+                                std::string(adapter) + ": pose of vertex id " +
+                                    std::to_string(vertex_id),
+                                error)) {
+      return false;
+    }
+  }
+  if (static_cast<int>(assembled.initial_poses.size()) != assembled.num_poses) {
+    return ConversionFail(
+        std::string(adapter) + ": duplicate vertex ids in the map", error);
+  }
+  return FinishFromCeresConstraints<Layout>(constraints, /*add_vertices=*/false,
+                                            &assembled, graph, error);
+}
+
+// PoseGraphToCeres2dConstraints / PoseGraphToCeres3dConstraints.
+template <typename Layout, typename Constraints>
+bool PoseGraphToCeresConstraints(const PoseGraph& graph,
+                                 Constraints* constraints, const char* adapter,
+                                 std::string* error) {
+  if (!CheckAdapterCall(constraints, "output", graph, Layout::kDimension,
+                        adapter, error)) {
+    return false;
+  }
+  std::string message;
+  if (!ValidatePoseGraph(graph, &message)) {
+    return ConversionFail(std::string(adapter) + ": " + message, error);
+  }
+  using Id = decltype(typename Constraints::value_type().id_begin);
+  for (int64_t id : graph.vertex_ids) {
+    Id key;
+    if (!VertexIdToKey(id, &key)) {
+      return ConversionFail(std::string(adapter) + ": vertex id " +
+                                std::to_string(id) +
+                                " does not fit the id type",
+                            error);
+    }
+  }
+  for (const RelativePoseMeasurement& m : graph.measurements) {
+    typename Constraints::value_type c;
+    c.id_begin = static_cast<Id>(graph.vertex_ids[m.i]);
+    c.id_end = static_cast<Id>(graph.vertex_ids[m.j]);
+    Layout::FromMeasurement(m, &c);
+    constraints->push_back(c);
+  }
   return true;
 }
 
@@ -374,264 +531,73 @@ bool PosesToIsometries(const Poses& poses,
 template <typename Map>
 bool PosesFromCeres2dMap(const PoseGraph& graph, const Map& poses, Poses* out,
                          std::string* error) {
-  if (out == nullptr) {
-    return internal::ConversionFail("PosesFromCeres2dMap: null output", error);
-  }
-  return internal::PosesFromCeresMap(
-      graph, poses, 2, "PosesFromCeres2dMap",
-      [](const auto& value) {
-        return PoseFromXYYaw(value.x, value.y, value.yaw_radians);
-      },
-      out, error);
+  return internal::PosesFromCeresMap<internal::Ceres2dLayout>(
+      graph, poses, "PosesFromCeres2dMap", out, error);
 }
 
 template <typename Map>
 bool PosesFromCeres3dMap(const PoseGraph& graph, const Map& poses, Poses* out,
                          std::string* error) {
-  if (out == nullptr) {
-    return internal::ConversionFail("PosesFromCeres3dMap: null output", error);
-  }
-  return internal::PosesFromCeresMap(
-      graph, poses, 3, "PosesFromCeres3dMap",
-      [](const auto& value) {
-        return PoseFromQuaternionTranslation(value.q, value.p);
-      },
-      out, error);
+  return internal::PosesFromCeresMap<internal::Ceres3dLayout>(
+      graph, poses, "PosesFromCeres3dMap", out, error);
 }
 
 template <typename Map>
 bool PosesToCeres2dMap(const PoseGraph& graph, const Poses& poses, Map* map,
                        std::string* error) {
-  return internal::PosesToCeresMap(
-      graph, poses, 2, "PosesToCeres2dMap",
-      [](const Pose& pose, auto* value) {
-        PoseToXYYaw(pose, &value->x, &value->y, &value->yaw_radians);
-      },
-      map, error);
+  return internal::PosesToCeresMap<internal::Ceres2dLayout>(
+      graph, poses, "PosesToCeres2dMap", map, error);
 }
 
 template <typename Map>
 bool PosesToCeres3dMap(const PoseGraph& graph, const Poses& poses, Map* map,
                        std::string* error) {
-  return internal::PosesToCeresMap(
-      graph, poses, 3, "PosesToCeres3dMap",
-      [](const Pose& pose, auto* value) {
-        Eigen::Quaterniond q;
-        Eigen::Vector3d t;
-        PoseToQuaternionTranslation(pose, &q, &t);
-        value->p = t;
-        value->q = q;
-      },
-      map, error);
+  return internal::PosesToCeresMap<internal::Ceres3dLayout>(
+      graph, poses, "PosesToCeres3dMap", map, error);
 }
 
 template <typename Constraints>
 bool PoseGraphFromCeres2dConstraints(const Constraints& constraints,
                                      PoseGraph* graph, std::string* error) {
-  PoseGraph assembled;
-  assembled.dimension = 2;
-  int index = 0;
-  for (const auto& c : constraints) {
-    const int64_t id_begin = static_cast<int64_t>(c.id_begin);
-    const int64_t id_end = static_cast<int64_t>(c.id_end);
-    RelativePoseMeasurement m;
-    if (!internal::MeasurementFromCeres2d(index, id_begin, id_end, c.x, c.y,
-                                          c.yaw_radians, c.information, &m,
-                                          error) ||
-        !internal::AddCeresMeasurement(index, id_begin, id_end,
-                                       /*add_vertices=*/true, std::move(m),
-                                       &assembled, error)) {
-      return false;
-    }
-    ++index;
-  }
-  return internal::FinishCeresPoseGraph(index, &assembled, graph, error);
+  return internal::PoseGraphFromCeresConstraints<internal::Ceres2dLayout>(
+      constraints, graph, error);
 }
 
 template <typename Constraints>
 bool PoseGraphFromCeres3dConstraints(const Constraints& constraints,
                                      PoseGraph* graph, std::string* error) {
-  PoseGraph assembled;
-  assembled.dimension = 3;
-  int index = 0;
-  for (const auto& c : constraints) {
-    const int64_t id_begin = static_cast<int64_t>(c.id_begin);
-    const int64_t id_end = static_cast<int64_t>(c.id_end);
-    RelativePoseMeasurement m;
-    if (!internal::MeasurementFromCeres3d(index, id_begin, id_end, c.t_be.p,
-                                          c.t_be.q, c.information, &m, error) ||
-        !internal::AddCeresMeasurement(index, id_begin, id_end,
-                                       /*add_vertices=*/true, std::move(m),
-                                       &assembled, error)) {
-      return false;
-    }
-    ++index;
-  }
-  return internal::FinishCeresPoseGraph(index, &assembled, graph, error);
+  return internal::PoseGraphFromCeresConstraints<internal::Ceres3dLayout>(
+      constraints, graph, error);
 }
 
 template <typename Map, typename Constraints>
 bool PoseGraphFromCeres2d(const Map& poses, const Constraints& constraints,
                           PoseGraph* graph, std::string* error) {
-  PoseGraph assembled;
-  assembled.dimension = 2;
-  for (const auto& [id, value] : poses) {
-    const int64_t vertex_id = static_cast<int64_t>(id);
-    assembled.AddVertex(vertex_id);
-    assembled.initial_poses.push_back(
-        PoseFromXYYaw(value.x, value.y, value.yaw_radians));
-    if (!internal::CheckPoseForConversion(
-            assembled.initial_poses.back(), 2,
-            "PoseGraphFromCeres2d: pose of vertex id " +
-                std::to_string(vertex_id),
-            error)) {
-      return false;
-    }
-  }
-  if (static_cast<int>(assembled.initial_poses.size()) != assembled.num_poses) {
-    return internal::ConversionFail(
-        "PoseGraphFromCeres2d: duplicate vertex ids in the map", error);
-  }
-  int index = 0;
-  for (const auto& c : constraints) {
-    const int64_t id_begin = static_cast<int64_t>(c.id_begin);
-    const int64_t id_end = static_cast<int64_t>(c.id_end);
-    RelativePoseMeasurement m;
-    if (!internal::MeasurementFromCeres2d(index, id_begin, id_end, c.x, c.y,
-                                          c.yaw_radians, c.information, &m,
-                                          error) ||
-        !internal::AddCeresMeasurement(index, id_begin, id_end,
-                                       /*add_vertices=*/false, std::move(m),
-                                       &assembled, error)) {
-      return false;
-    }
-    ++index;
-  }
-  return internal::FinishCeresPoseGraph(index, &assembled, graph, error);
+  return internal::PoseGraphFromCeresMap<internal::Ceres2dLayout>(
+      poses, constraints, "PoseGraphFromCeres2d", graph, error);
 }
 
 template <typename Map, typename Constraints>
 bool PoseGraphFromCeres3d(const Map& poses, const Constraints& constraints,
                           PoseGraph* graph, std::string* error) {
-  PoseGraph assembled;
-  assembled.dimension = 3;
-  for (const auto& [id, value] : poses) {
-    const int64_t vertex_id = static_cast<int64_t>(id);
-    assembled.AddVertex(vertex_id);
-    assembled.initial_poses.push_back(
-        PoseFromQuaternionTranslation(value.q, value.p));
-    if (!internal::CheckPoseForConversion(
-            assembled.initial_poses.back(), 3,
-            "PoseGraphFromCeres3d: pose of vertex id " +
-                std::to_string(vertex_id),
-            error)) {
-      return false;
-    }
-  }
-  if (static_cast<int>(assembled.initial_poses.size()) != assembled.num_poses) {
-    return internal::ConversionFail(
-        "PoseGraphFromCeres3d: duplicate vertex ids in the map", error);
-  }
-  int index = 0;
-  for (const auto& c : constraints) {
-    const int64_t id_begin = static_cast<int64_t>(c.id_begin);
-    const int64_t id_end = static_cast<int64_t>(c.id_end);
-    RelativePoseMeasurement m;
-    if (!internal::MeasurementFromCeres3d(index, id_begin, id_end, c.t_be.p,
-                                          c.t_be.q, c.information, &m, error) ||
-        !internal::AddCeresMeasurement(index, id_begin, id_end,
-                                       /*add_vertices=*/false, std::move(m),
-                                       &assembled, error)) {
-      return false;
-    }
-    ++index;
-  }
-  return internal::FinishCeresPoseGraph(index, &assembled, graph, error);
+  return internal::PoseGraphFromCeresMap<internal::Ceres3dLayout>(
+      poses, constraints, "PoseGraphFromCeres3d", graph, error);
 }
 
 template <typename Constraints>
 bool PoseGraphToCeres2dConstraints(const PoseGraph& graph,
                                    Constraints* constraints,
                                    std::string* error) {
-  if (constraints == nullptr) {
-    return internal::ConversionFail(
-        "PoseGraphToCeres2dConstraints: null output", error);
-  }
-  if (!internal::CheckGraphForAdapter(graph, 2, "PoseGraphToCeres2dConstraints",
-                                      error)) {
-    return false;
-  }
-  std::string message;
-  if (!ValidatePoseGraph(graph, &message)) {
-    return internal::ConversionFail("PoseGraphToCeres2dConstraints: " + message,
-                                    error);
-  }
-  using Id = decltype(typename Constraints::value_type().id_begin);
-  for (int64_t id : graph.vertex_ids) {
-    Id key;
-    if (!internal::VertexIdToKey(id, &key)) {
-      return internal::ConversionFail(
-          "PoseGraphToCeres2dConstraints: vertex id " + std::to_string(id) +
-              " does not fit the id type",
-          error);
-    }
-  }
-  for (const RelativePoseMeasurement& m : graph.measurements) {
-    typename Constraints::value_type c;
-    c.id_begin = static_cast<Id>(graph.vertex_ids[m.i]);
-    c.id_end = static_cast<Id>(graph.vertex_ids[m.j]);
-    c.x = m.t(0);
-    c.y = m.t(1);
-    c.yaw_radians = std::atan2(m.R(1, 0), m.R(0, 0));
-    c.information =
-        Eigen::Vector3d(m.tau, m.tau, m.kappa).asDiagonal().toDenseMatrix();
-    constraints->push_back(c);
-  }
-  return true;
+  return internal::PoseGraphToCeresConstraints<internal::Ceres2dLayout>(
+      graph, constraints, "PoseGraphToCeres2dConstraints", error);
 }
 
 template <typename Constraints>
 bool PoseGraphToCeres3dConstraints(const PoseGraph& graph,
                                    Constraints* constraints,
                                    std::string* error) {
-  if (constraints == nullptr) {
-    return internal::ConversionFail(
-        "PoseGraphToCeres3dConstraints: null output", error);
-  }
-  if (!internal::CheckGraphForAdapter(graph, 3, "PoseGraphToCeres3dConstraints",
-                                      error)) {
-    return false;
-  }
-  std::string message;
-  if (!ValidatePoseGraph(graph, &message)) {
-    return internal::ConversionFail("PoseGraphToCeres3dConstraints: " + message,
-                                    error);
-  }
-  using Id = decltype(typename Constraints::value_type().id_begin);
-  for (int64_t id : graph.vertex_ids) {
-    Id key;
-    if (!internal::VertexIdToKey(id, &key)) {
-      return internal::ConversionFail(
-          "PoseGraphToCeres3dConstraints: vertex id " + std::to_string(id) +
-              " does not fit the id type",
-          error);
-    }
-  }
-  for (const RelativePoseMeasurement& m : graph.measurements) {
-    typename Constraints::value_type c;
-    c.id_begin = static_cast<Id>(graph.vertex_ids[m.i]);
-    c.id_end = static_cast<Id>(graph.vertex_ids[m.j]);
-    Eigen::Quaterniond q;
-    Eigen::Vector3d t;
-    PoseToQuaternionTranslation(Pose{m.R, m.t}, &q, &t);
-    c.t_be.p = t;
-    c.t_be.q = q;
-    Eigen::Matrix<double, 6, 1> diagonal;
-    diagonal << m.tau, m.tau, m.tau, 2 * m.kappa, 2 * m.kappa, 2 * m.kappa;
-    c.information = diagonal.asDiagonal().toDenseMatrix();
-    constraints->push_back(c);
-  }
-  return true;
+  return internal::PoseGraphToCeresConstraints<internal::Ceres3dLayout>(
+      graph, constraints, "PoseGraphToCeres3dConstraints", error);
 }
 
 }  // namespace ceres_sesync
