@@ -55,6 +55,9 @@ class CertificateMatrix {
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }
+  // CHOLMOD chose a supernodal factor: factorizations cost much more than
+  // products with Q (3D graphs).
+  bool supernodal() const { return factor_.IsSupernodal(); }
 
  private:
   int d_ = 0, n_ = 0, translation_size_ = 0, rotation_size_ = 0;

@@ -146,6 +146,11 @@ std::vector<int> CholmodFactor::Ordering() const {
   return std::vector<int>(perm, perm + m_cholmodFactor->n);
 }
 
+bool CholmodFactor::IsSupernodal() const {
+  CHECK(m_cholmodFactor != nullptr);
+  return m_cholmodFactor->is_super;
+}
+
 void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
   factor->setMode(layout == CholmodLayout::kSimplicial
                       ? Eigen::CholmodSimplicialLLt

@@ -52,6 +52,9 @@ class CholmodFactor
                                   std::vector<int> ordering);
   // After analyzePattern(): CHOLMOD's fill-reducing ordering.
   std::vector<int> Ordering() const;
+  // After analyzePattern(): whether CHOLMOD chose the supernodal layout
+  // (dense fill, expensive factorizations).
+  bool IsSupernodal() const;
 };
 
 // How CHOLMOD organizes the factor. Simplicial: fast for the very sparse
