@@ -132,7 +132,12 @@ std::string Certificate::FullReport() const {
   };
   line("%-36s %.12g\n", "Objective F(candidate)", objective);
   line("%-36s %.12g\n", "F with optimal translations", rotation_objective);
-  line("%-36s %.3e\n", "lambda_min(S) estimate", lambda_min);
+  if (std::isnan(lambda_min)) {
+    line("%-36s %s\n", "lambda_min(S) estimate",
+         "not computed (Cholesky test sufficed)");
+  } else {
+    line("%-36s %.3e\n", "lambda_min(S) estimate", lambda_min);
+  }
   line("%-36s %.3e\n", "eta (S + eta I proven PSD)", eta);
   line("%-36s %.12g\n", "Lower bound on the optimum", lower_bound);
   line("%-36s %.3e\n", "Suboptimality bound", suboptimality_bound);

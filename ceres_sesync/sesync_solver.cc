@@ -220,6 +220,11 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
       }
     }
     cost.Evaluate(Y);  // Make Y current (Lambda at Y).
+    if (use_ceres) {
+      Eigen::MatrixXd gradient;
+      cost.Gradient(&gradient);
+      level.gradient_norm = gradient.norm();
+    }
     level.optimize_time_s = Seconds(t);
     // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
     sdp_value = 0;
@@ -310,6 +315,9 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
     if (rounded > sdp_value * (1 + 1e-12)) {
       RiemannianTrustRegionSummary refine_summary;
       rtr.callback = nullptr;
+      if (options.max_time_s > 0) {
+        rtr.max_time_s = std::max(1e-3, options.max_time_s - Seconds(start));
+      }
       rtr.preconditioned_gradient_tolerance =
           options.relative_preconditioned_gradient_tolerance *
           std::sqrt(rounded);
@@ -434,7 +442,12 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %.3e\n", "Relative suboptimality bound",
        relative_suboptimality_bound);
   line("%-34s %.3e\n", "eta (S + eta I proven PD)", eta);
-  line("%-34s %.3e\n", "lambda_min(S) estimate", lambda_min_estimate);
+  if (std::isnan(lambda_min_estimate)) {
+    line("%-34s %s\n", "lambda_min(S) estimate",
+         "not computed (Cholesky test sufficed)");
+  } else {
+    line("%-34s %.3e\n", "lambda_min(S) estimate", lambda_min_estimate);
+  }
   line("%-34s %d\n", "Final rank", final_rank);
   line("%-34s %d\n", "Trust-region iterations", iterations);
   line("%-34s %d\n", "Hessian-vector products", hessian_vector_products);
