@@ -58,6 +58,9 @@
 DEFINE_bool(quick, false,
             "Only tinyGrid3D, smallGrid3D, CSAIL and intel, one repeat.");
 DEFINE_int32(repeats, 3, "Timed repeats per method (min and median kept).");
+DEFINE_int32(num_threads, 1,
+             "Threads for every method alike: SolverOptions::num_threads, "
+             "CertifyOptions::num_threads and Ceres's num_threads.");
 DEFINE_int32(odometry_repeats, 1,
              "Repeats of the Ceres runs from the file's initial guess "
              "(capped by --repeats).");
@@ -162,7 +165,9 @@ void CertifyInto(const PoseGraph& graph, const Poses& poses, Row* row,
   Certificate certificate;
   std::string error;
   const auto start = Clock::now();
-  if (!Certify(graph, poses, CertifyOptions(), &certificate, &error)) {
+  CertifyOptions options;
+  options.num_threads = FLAGS_num_threads;
+  if (!Certify(graph, poses, options, &certificate, &error)) {
     row->certified = "error";
     row->status = "certify error: " + error;
     LOG(WARNING) << row->dataset << " " << row->method << "/" << row->init
@@ -213,6 +218,7 @@ Row RunCeres(const PoseGraph& graph, const std::string& dataset,
   CeresBaselineOptions options;
   options.method = method;
   options.max_solver_time_s = FLAGS_ceres_max_time;
+  options.num_threads = FLAGS_num_threads;
   Poses result;
   CeresBaselineSummary summary;
   for (int r = 0; r < repeats; ++r) {
@@ -351,7 +357,9 @@ bool BenchDataset(const std::string& path, int repeats,
     Row sesync;
     Stages stage;
     Poses sesync_poses;
-    if (!RunSESync(graph, dataset, "SE-Sync", SolverOptions(), repeats, &sesync,
+    SolverOptions sesync_options;
+    sesync_options.num_threads = FLAGS_num_threads;
+    if (!RunSESync(graph, dataset, "SE-Sync", sesync_options, repeats, &sesync,
                    &stage, &sesync_poses)) {
       return false;
     }
@@ -392,6 +400,7 @@ bool BenchDataset(const std::string& path, int repeats,
     SolverOptions options;
     options.local_solver = SolverOptions::LocalSolver::kCeresLbfgs;
     options.max_time_s = FLAGS_lbfgs_max_time;
+    options.num_threads = FLAGS_num_threads;
     Row row;
     Stages stage;
     Poses poses;
