@@ -14,30 +14,14 @@ namespace {
 // A fill-reducing ordering of K from one of the pose graph: K has the pattern
 // of the translational Laplacian with every vertex expanded into its
 // translation (absent for vertex 0) and d rotation unknowns, so ordering the
-// n vertices (CHOLMOD's AMD/METIS choice on the n x n pattern, 1 / (d+1)^2
-// of K's entries) and expanding gives K's ordering at a fraction of the cost.
+// n vertices (1 / (d+1)^2 of K's entries) and expanding gives K's ordering at
+// a fraction of the cost of ordering K itself.
 std::vector<int> BlockOrdering(const SESyncProblem& problem) {
   const int n = problem.num_poses(), d = problem.dimension();
-  // The pose graph's pattern (lower triangle) from D's block pattern: block
-  // (i, j) of D is stored (structurally) iff i == j or i ~ j.
-  const SparseMatrix& D = problem.D();
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(D.nonZeros() / (d * d) + n);
-  for (int j = 0; j < n; ++j) {
-    for (SparseMatrix::InnerIterator it(D, d * j); it; ++it) {
-      const int i = static_cast<int>(it.row()) / d;
-      if (it.row() % d == 0 && i >= j) t.emplace_back(i, j, 1.0);
-    }
-  }
-  SparseMatrix pattern(n, n);
-  pattern.setFromTriplets(t.begin(), t.end());
-  CholmodFactor vertex_factor;
-  ConfigureCholmod(CholmodLayout::kSimplicial, &vertex_factor);
-  vertex_factor.analyzePattern(pattern);
   const int t0 = n - 1;
   std::vector<int> ordering;
   ordering.reserve(t0 + d * n);
-  for (int v : vertex_factor.Ordering()) {
+  for (int v : problem.vertex_ordering()) {
     if (v > 0) ordering.push_back(v - 1);
     for (int a = 0; a < d; ++a) ordering.push_back(t0 + d * v + a);
   }

@@ -217,12 +217,30 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   Lbar_.resize(n - 1, n - 1);
   Lbar_.setFromTriplets(lbar.begin(), lbar.end());
   if (n == 1) {
+    vertex_ordering_ = {0};
     ok_ = true;
     return;
   }
+  // One fill-reducing ordering of the pose graph (CHOLMOD's choice on the
+  // pattern of L(W^tau)) serves Lbar here and the augmented matrices of
+  // certificate_matrix.h.
+  {
+    SparseMatrix pattern(n, n);
+    pattern.setFromTriplets(lw.begin(), lw.end());
+    CholmodFactor analysis;
+    ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
+    analysis.analyzePattern(pattern);
+    vertex_ordering_ = analysis.Ordering();
+  }
+  std::vector<int> lbar_ordering;
+  lbar_ordering.reserve(n - 1);
+  for (int vertex : vertex_ordering_) {
+    if (vertex > 0) lbar_ordering.push_back(vertex - 1);
+  }
   lbar_factor_ = std::make_unique<CholmodFactor>();
   ConfigureCholmod(CholmodLayout::kSimplicial, lbar_factor_.get());
-  lbar_factor_->compute(Lbar_);
+  lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
+  lbar_factor_->factorize(Lbar_);
   ok_ = lbar_factor_->info() == Eigen::Success;
   if (ok_) lbar_solver_ = lbar_factor_->ExtractFactor();
   LOG_IF(ERROR, !ok_) << "Cholesky factorization of the reduced translational "

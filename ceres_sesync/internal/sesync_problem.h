@@ -97,7 +97,11 @@ class SESyncProblem {
   // Lbar: L(W^tau) without its first row and column (lower triangle stored).
   const SparseMatrix& Lbar() const { return Lbar_; }
   // The rotational connection Laplacian L(G^rho) alone (dn x dn).
-  const SparseMatrix& RotationLaplacian() const { return Lrho_; }
+  const SparseMatrix& RotationLaplacian() const {
+    return Lrho_;
+  }  // A fill-reducing ordering of the n poses (from the pattern of L(W^tau)):
+  // ordering[k] = pose eliminated k-th.
+  const std::vector<int>& vertex_ordering() const { return vertex_ordering_; }
 
  private:
   int d_ = 0, n_ = 0, num_threads_ = 1;
@@ -105,6 +109,7 @@ class SESyncProblem {
   SparseMatrix D_, Lrho_, Vbar_, VbarT_, minus_Vbar_, Lbar_;
   std::unique_ptr<CholmodFactor> lbar_factor_;
   SparseCholeskyFactor lbar_solver_;  // The same factor, for MultiplyQ.
+  std::vector<int> vertex_ordering_;
 };
 
 // out_i = V_i * Lambda_i for the d x d blocks Lambda (d x dn) and the r x d
