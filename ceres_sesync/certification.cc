@@ -30,6 +30,7 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
                 " poses, the graph has " + std::to_string(n));
   }
   Certificate c;
+  c.strict_round_off = options.strict_round_off;
   Poses projected = candidate;
   Eigen::MatrixXd R(d, d * n);
   for (int i = 0; i < n; ++i) {
@@ -74,7 +75,7 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
     const double eta_target =
         std::max(options.target_relative_bound * std::abs(trace) / (d * n),
                  std::numeric_limits<double>::min());
-    internal::CertificateMatrix matrix(problem);
+    internal::CertificateMatrix matrix(problem, options.strict_round_off);
     const internal::VerificationResult v = internal::VerifyCertificate(
         problem, Lambda, eta_target, std::max(eta_max, 0.0), &matrix);
     c.eta = v.eta;
@@ -138,7 +139,9 @@ std::string Certificate::FullReport() const {
   } else {
     line("%-36s %.3e\n", "lambda_min(S) estimate", lambda_min);
   }
-  line("%-36s %.3e\n", "eta (S + eta I proven PSD)", eta);
+  line("%-36s %.3e (%s)\n", "eta (S + eta I proven PSD)", eta,
+       strict_round_off ? "all round-off rigorous"
+                        : "translation-block round-off to first order");
   line("%-36s %.12g\n", "Lower bound on the optimum", lower_bound);
   line("%-36s %.3e\n", "Suboptimality bound", suboptimality_bound);
   line("%-36s %.3e\n", "Relative suboptimality bound",

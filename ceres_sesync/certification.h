@@ -30,12 +30,13 @@
 //
 // Floating point: a Cholesky factorization that completes proves K + E
 // positive definite for the computed factor's backward error E. eta includes
-// a rigorous worst-case bound on ||E||_2 (componentwise bound of Demmel 1989,
-// Higham Thm. 10.5, widened 4x for blocked summation), so the certificate is
-// sound for the translation-augmented matrix K. Round-off in K's translation
-// block reaches S amplified by ||Lbar^{-1} Vbar||^2 in the worst case; that
-// amplification is not added (it is far from attained by Cholesky's actual
-// componentwise errors, and would make every long trajectory uncertifiable).
+// a rigorous worst-case bound on E (componentwise bound of Demmel 1989,
+// Higham Thm. 10.5, widened 4x for blocked summation, applied row by row),
+// and the factorized matrix has its translation block lowered by at least the
+// bound of the translation rows (Lbar - mu I), so that the proof carries over
+// exactly to S + eta I with nothing amplified through Lbar^{-1}. The proof is
+// for the data matrices as computed from the file (their own round-off,
+// ~1e-16 relative per entry, is not propagated).
 // Local minima from local search have lambda_min(S) many orders of magnitude
 // below these allowances, so they are never certified.
 
@@ -67,6 +68,8 @@ struct CertifyOptions {
   // Threads for the products with Q (<= 0: all cores); see
   // SolverOptions::num_threads.
   int num_threads = 0;
+  // See SolverOptions::strict_round_off.
+  bool strict_round_off = false;
 };
 
 struct Certificate {
@@ -84,6 +87,9 @@ struct Certificate {
   // Shift for which S + eta I was proven positive semidefinite (including the
   // factorization's backward-error allowance); +inf if none.
   double eta = 0;
+  // eta accounts rigorously for all round-off (CertifyOptions::
+  // strict_round_off), not the translation block's to first order only.
+  bool strict_round_off = false;
   // Proven lower bound on the optimal value: max(0, tr(Lambda) - eta d n)
   // (F is a sum of squares). A candidate with F <= 1e-12 * sum(kappa + tau)
   // (e.g. a tree, or noiseless data) is certified by F >= 0 alone.

@@ -79,6 +79,7 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
   s.dimension = graph.dimension;
   s.num_poses = graph.num_poses;
   s.num_measurements = static_cast<int>(graph.measurements.size());
+  s.strict_round_off = options.strict_round_off;
   if (!ValidatePoseGraph(graph, &s.message)) {
     s.status = SolverSummary::Status::kInvalidInput;
     return {};
@@ -112,7 +113,7 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
     s.message = "the translational Laplacian is not positive definite";
     return {};
   }
-  internal::CertificateMatrix certificate(problem);
+  internal::CertificateMatrix certificate(problem, options.strict_round_off);
   internal::SESyncPreconditioner preconditioner(
       problem, ToInternal(options.preconditioner),
       options.regularized_cholesky_max_condition, &certificate);
@@ -441,7 +442,9 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %.3e\n", "Suboptimality bound", suboptimality_bound);
   line("%-34s %.3e\n", "Relative suboptimality bound",
        relative_suboptimality_bound);
-  line("%-34s %.3e\n", "eta (S + eta I proven PD)", eta);
+  line("%-34s %.3e (%s)\n", "eta (S + eta I proven PD)", eta,
+       strict_round_off ? "all round-off rigorous"
+                        : "translation-block round-off to first order");
   if (std::isnan(lambda_min_estimate)) {
     line("%-34s %s\n", "lambda_min(S) estimate",
          "not computed (Cholesky test sufficed)");

@@ -169,35 +169,37 @@ TEST_F(CertificateTest, FactorizeAgreesWithDenseEigenvalues) {
   for (const RandomGraphOptions& o : Graphs()) {
     instances_.clear();
     Build(o);
-    CertificateMatrix matrix(*problem_);
-    EXPECT_EQ(matrix.dimension(), o.dimension * o.num_poses);
-    for (const Instance& in : instances_) {
-      const double lmin = in.lambda_min, s = in.scale;
-      struct Shift {
-        double c;
-        bool must_succeed;
-      };
-      std::vector<Shift> shifts = {
-          {-lmin + 1e-3 * s, true},   // lambda_min(S + cI) = 1e-3 ||S||.
-          {-lmin - 1e-3 * s, false},  // lambda_min(S + cI) = -1e-3 ||S||.
-          {-lmin + 1e-6 * s, true},
-          {-lmin - 1e-6 * s, false}};
-      if (lmin < -1e-6 * s) {
-        // Straddle -lambda_min by a factor 2 both ways (brief's test); the
-        // "fail" case is lambda_min(S) = -2c: SOUNDNESS.
-        shifts.push_back({-2 * lmin, true});
-        shifts.push_back({-0.5 * lmin, false});
-        shifts.push_back({-1.1 * lmin, true});
-        shifts.push_back({-0.9 * lmin, false});
-      }
-      for (const Shift& sh : shifts) {
-        const bool ok = matrix.Factorize(in.Lambda, sh.c);
-        EXPECT_EQ(ok, sh.must_succeed)
-            << in.name << ": d " << o.dimension << " n " << o.num_poses
-            << " lambda_min(S) " << lmin << " c " << sh.c << " ||S|| " << s;
-        if (ok) {
-          EXPECT_GE(matrix.proven_shift(), sh.c);
-          EXPECT_GE(lmin, -matrix.proven_shift() - 1e-13 * s) << in.name;
+    for (bool strict : {false, true}) {
+      CertificateMatrix matrix(*problem_, strict);
+      EXPECT_EQ(matrix.dimension(), o.dimension * o.num_poses);
+      for (const Instance& in : instances_) {
+        const double lmin = in.lambda_min, s = in.scale;
+        struct Shift {
+          double c;
+          bool must_succeed;
+        };
+        std::vector<Shift> shifts = {
+            {-lmin + 1e-3 * s, true},   // lambda_min(S + cI) = 1e-3 ||S||.
+            {-lmin - 1e-3 * s, false},  // lambda_min(S + cI) = -1e-3 ||S||.
+            {-lmin + 1e-6 * s, true},
+            {-lmin - 1e-6 * s, false}};
+        if (lmin < -1e-6 * s) {
+          // Straddle -lambda_min by a factor 2 both ways (brief's test); the
+          // "fail" case is lambda_min(S) = -2c: SOUNDNESS.
+          shifts.push_back({-2 * lmin, true});
+          shifts.push_back({-0.5 * lmin, false});
+          shifts.push_back({-1.1 * lmin, true});
+          shifts.push_back({-0.9 * lmin, false});
+        }
+        for (const Shift& sh : shifts) {
+          const bool ok = matrix.Factorize(in.Lambda, sh.c);
+          EXPECT_EQ(ok, sh.must_succeed)
+              << in.name << ": d " << o.dimension << " n " << o.num_poses
+              << " lambda_min(S) " << lmin << " c " << sh.c << " ||S|| " << s;
+          if (ok) {
+            EXPECT_GE(matrix.proven_shift(), sh.c);
+            EXPECT_GE(lmin, -matrix.proven_shift() - 1e-13 * s) << in.name;
+          }
         }
       }
     }
@@ -213,26 +215,28 @@ TEST_F(CertificateTest, NoFalseCertificateAtSmallShifts) {
   for (const RandomGraphOptions& o : Graphs()) {
     instances_.clear();
     Build(o);
-    CertificateMatrix matrix(*problem_);
-    const Instance& in = instances_[0];  // The optimum: lambda_min ~ 0.
-    const int d = in.d;
-    const double s = in.scale;
-    for (double relative : {1e-6, 1e-8, 1e-9, 1e-10, 1e-11}) {
-      const double c = relative * s;
-      // Lambda' = Lambda + mu I: lambda_min(Q - Lambda') = lambda_min - mu.
-      const double mu = in.lambda_min + 2 * c;
-      MatrixXd shifted = in.Lambda;
-      for (int i = 0; i < in.n; ++i) {
-        shifted.middleCols(d * i, d) += mu * MatrixXd::Identity(d, d);
-      }
-      const bool ok = matrix.Factorize(shifted, c);
-      if (ok) {
-        // Only acceptable if the proven shift accounts for the gap.
-        EXPECT_GE(matrix.proven_shift(), 2 * c * (1 - 1e-6))
-            << "FALSE CERTIFICATE: lambda_min(S) = " << -2 * c
-            << " but K_c factorized with proven_shift " << matrix.proven_shift()
-            << " (c = " << c << ", ||S|| = " << s << ", d " << d << " n "
-            << in.n << ")";
+    for (bool strict : {false, true}) {
+      CertificateMatrix matrix(*problem_, strict);
+      const Instance& in = instances_[0];  // The optimum: lambda_min ~ 0.
+      const int d = in.d;
+      const double s = in.scale;
+      for (double relative : {1e-6, 1e-8, 1e-9, 1e-10, 1e-11}) {
+        const double c = relative * s;
+        // Lambda' = Lambda + mu I: lambda_min(Q - Lambda') = lambda_min - mu.
+        const double mu = in.lambda_min + 2 * c;
+        MatrixXd shifted = in.Lambda;
+        for (int i = 0; i < in.n; ++i) {
+          shifted.middleCols(d * i, d) += mu * MatrixXd::Identity(d, d);
+        }
+        const bool ok = matrix.Factorize(shifted, c);
+        if (ok) {
+          // Only acceptable if the proven shift accounts for the gap.
+          EXPECT_GE(matrix.proven_shift(), 2 * c * (1 - 1e-6))
+              << "FALSE CERTIFICATE: lambda_min(S) = " << -2 * c
+              << " but K_c factorized with proven_shift "
+              << matrix.proven_shift() << " (c = " << c << ", ||S|| = " << s
+              << ", d " << d << " n " << in.n << ", strict " << strict << ")";
+        }
       }
     }
   }
@@ -244,26 +248,42 @@ TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
   for (const RandomGraphOptions& o : Graphs()) {
     instances_.clear();
     Build(o);
-    CertificateMatrix matrix(*problem_);
-    if (o.num_loop_closures >= 10 * o.num_poses) {
-      EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
-    }
-    for (const Instance& in : instances_) {
-      const int dn = in.d * in.n;
-      // lambda_min(S + cI) = 1e-3 ||S||: condition number <= ~1e3.
-      const double c = -in.lambda_min + 1e-3 * in.scale;
-      ASSERT_TRUE(matrix.Factorize(in.Lambda, c));
-      const MatrixXd shifted = in.S + c * MatrixXd::Identity(dn, dn);
-      std::normal_distribution<double> normal;
-      MatrixXd Y(dn, 3);
-      for (int k = 0; k < Y.size(); ++k) Y.data()[k] = normal(rng);
-      const MatrixXd expected = shifted.ldlt().solve(Y);
-      MatrixXd X;
-      matrix.SolveShifted(Y, &X);
-      EXPECT_LT((X - expected).norm(), 1e-9 * expected.norm()) << in.name;
-      VectorXd x;
-      matrix.SolveShifted(VectorXd(Y.col(1)), &x);
-      EXPECT_LT((x - expected.col(1)).norm(), 1e-9 * expected.col(1).norm());
+    const MatrixXd M = test_util::DenseDataMatrix(graph_);
+    for (bool strict : {false, true}) {
+      CertificateMatrix matrix(*problem_, strict);
+      if (o.num_loop_closures >= 10 * o.num_poses) {
+        EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
+      }
+      for (const Instance& in : instances_) {
+        const int dn = in.d * in.n;
+        // lambda_min(S + cI) = 1e-3 ||S||: condition number <= ~1e3.
+        const double c = -in.lambda_min + 1e-3 * in.scale;
+        ASSERT_TRUE(matrix.Factorize(in.Lambda, c));
+        // The factor is of K_c with the translation block Lbar - mu I: its
+        // Schur complement S_mu + cI, computed densely here.
+        const double mu = matrix.translation_shift();
+        EXPECT_EQ(mu > 0, strict);
+        const int n1 = in.n - 1;
+        const MatrixXd Lbar =
+            M.block(1, 1, n1, n1) - mu * MatrixXd::Identity(n1, n1);
+        const MatrixXd V = M.block(1, in.n, n1, dn);
+        const MatrixXd S_mu = M.bottomRightCorner(dn, dn) -
+                              V.transpose() * Lbar.llt().solve(V) -
+                              test_util::BlockDiagonalToDense(in.Lambda, in.d);
+        const MatrixXd shifted = S_mu + c * MatrixXd::Identity(dn, dn);
+        // S_mu <= S, and for mu at round-off level nearly equal.
+        EXPECT_LT((S_mu - in.S).norm(), 1e-6 * in.scale) << in.name;
+        std::normal_distribution<double> normal;
+        MatrixXd Y(dn, 3);
+        for (int k = 0; k < Y.size(); ++k) Y.data()[k] = normal(rng);
+        const MatrixXd expected = shifted.ldlt().solve(Y);
+        MatrixXd X;
+        matrix.SolveShifted(Y, &X);
+        EXPECT_LT((X - expected).norm(), 1e-9 * expected.norm()) << in.name;
+        VectorXd x;
+        matrix.SolveShifted(VectorXd(Y.col(1)), &x);
+        EXPECT_LT((x - expected.col(1)).norm(), 1e-9 * expected.col(1).norm());
+      }
     }
   }
 }
@@ -274,60 +294,62 @@ TEST_F(CertificateTest, VerifyCertificateAgreesWithDenseSpectrum) {
   for (const RandomGraphOptions& o : Graphs()) {
     instances_.clear();
     Build(o);
-    CertificateMatrix matrix(*problem_);
-    if (o.num_loop_closures >= 10 * o.num_poses) {
-      EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
-    }
-    for (const Instance& in : instances_) {
-      const int dn = in.d * in.n;
-      const double eta_target = 1e-9 * in.f / dn;
-      const double eta_max = 1e-6 * in.f / dn;
-      const VerificationResult v = internal::VerifyCertificate(
-          *problem_, in.Lambda, eta_target, eta_max, &matrix);
-      SCOPED_TRACE(in.name + " d " + std::to_string(in.d) + " n " +
-                   std::to_string(in.n) + " dense lambda_min " +
-                   std::to_string(in.lambda_min));
-      EXPECT_GE(v.factorizations, 1);
-      if (in.name == "optimum") {
-        EXPECT_TRUE(v.certified) << "eta " << v.eta;
-      } else {
-        // Far from optimal: lambda_min(S) is O(1) negative.
-        EXPECT_LT(in.lambda_min, -eta_max);
-        EXPECT_FALSE(v.certified);
+    for (bool strict : {false, true}) {
+      CertificateMatrix matrix(*problem_, strict);
+      if (o.num_loop_closures >= 10 * o.num_poses) {
+        EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
       }
-      // Whatever the outcome, the proven shift must be sound.
-      if (std::isfinite(v.eta)) {
-        EXPECT_GE(in.lambda_min, -v.eta * (1 + 1e-9) - 1e-13 * in.scale)
-            << "eta " << v.eta;
-      }
-      if (v.certified) {
-        EXPECT_LE(v.eta, eta_max);
-      } else {
-        EXPECT_FALSE(v.eigensolver_failed);
-        ASSERT_EQ(v.direction.size(), dn);
-        EXPECT_NEAR(v.direction.norm(), 1.0, 1e-10);
-        const double curvature = v.direction.dot(in.S * v.direction);
-        EXPECT_LT(curvature, 0.0);
-        EXPECT_NEAR(v.direction_curvature, curvature, 1e-9 * in.scale);
-        // Simplicial: Lanczos on (S + cI)^{-1} with tolerance 1e-8, c within
-        // 16x of -lambda_min: 1e-6 relative. Supernodal: the Rayleigh
-        // quotient of a Lanczos-on-S Ritz vector (tolerance 1e-3), an upper
-        // bound on lambda_min.
-        const double accuracy = matrix.supernodal() ? 1e-2 : 1e-6;
-        EXPECT_NEAR(v.lambda_min_estimate, in.lambda_min,
-                    accuracy * std::abs(in.lambda_min));
-        EXPECT_GE(v.lambda_min_estimate,
-                  in.lambda_min - 1e-9 * std::abs(in.lambda_min));
-      }
+      for (const Instance& in : instances_) {
+        const int dn = in.d * in.n;
+        const double eta_target = 1e-9 * in.f / dn;
+        const double eta_max = 1e-6 * in.f / dn;
+        const VerificationResult v = internal::VerifyCertificate(
+            *problem_, in.Lambda, eta_target, eta_max, &matrix);
+        SCOPED_TRACE(in.name + " d " + std::to_string(in.d) + " n " +
+                     std::to_string(in.n) + " dense lambda_min " +
+                     std::to_string(in.lambda_min));
+        EXPECT_GE(v.factorizations, 1);
+        if (in.name == "optimum") {
+          EXPECT_TRUE(v.certified) << "eta " << v.eta;
+        } else {
+          // Far from optimal: lambda_min(S) is O(1) negative.
+          EXPECT_LT(in.lambda_min, -eta_max);
+          EXPECT_FALSE(v.certified);
+        }
+        // Whatever the outcome, the proven shift must be sound.
+        if (std::isfinite(v.eta)) {
+          EXPECT_GE(in.lambda_min, -v.eta * (1 + 1e-9) - 1e-13 * in.scale)
+              << "eta " << v.eta;
+        }
+        if (v.certified) {
+          EXPECT_LE(v.eta, eta_max);
+        } else {
+          EXPECT_FALSE(v.eigensolver_failed);
+          ASSERT_EQ(v.direction.size(), dn);
+          EXPECT_NEAR(v.direction.norm(), 1.0, 1e-10);
+          const double curvature = v.direction.dot(in.S * v.direction);
+          EXPECT_LT(curvature, 0.0);
+          EXPECT_NEAR(v.direction_curvature, curvature, 1e-9 * in.scale);
+          // Simplicial: Lanczos on (S + cI)^{-1} with tolerance 1e-8, c within
+          // 16x of -lambda_min: 1e-6 relative. Supernodal: the Rayleigh
+          // quotient of a Lanczos-on-S Ritz vector (tolerance 1e-3), an upper
+          // bound on lambda_min.
+          const double accuracy = matrix.supernodal() ? 1e-2 : 1e-6;
+          EXPECT_NEAR(v.lambda_min_estimate, in.lambda_min,
+                      accuracy * std::abs(in.lambda_min));
+          EXPECT_GE(v.lambda_min_estimate,
+                    in.lambda_min - 1e-9 * std::abs(in.lambda_min));
+        }
 
-      // With a generous eta_max every instance is certified with a sound
-      // eta in [-lambda_min, eta_max].
-      const double generous = 4 * std::abs(in.lambda_min) + 1e-6 * in.scale;
-      const VerificationResult w = internal::VerifyCertificate(
-          *problem_, in.Lambda, eta_target, generous, &matrix);
-      EXPECT_TRUE(w.certified);
-      EXPECT_LE(w.eta, generous);
-      EXPECT_GE(in.lambda_min, -w.eta * (1 + 1e-9) - 1e-13 * in.scale);
+        // With a generous eta_max every instance is certified with a sound
+        // eta in [-lambda_min, eta_max].
+        const double generous = 4 * std::abs(in.lambda_min) + 1e-6 * in.scale;
+        const VerificationResult w = internal::VerifyCertificate(
+            *problem_, in.Lambda, eta_target, generous, &matrix);
+        EXPECT_TRUE(w.certified);
+        EXPECT_LE(w.eta, generous);
+        EXPECT_GE(in.lambda_min, -w.eta * (1 + 1e-9) - 1e-13 * in.scale);
+      }
     }
   }
 }

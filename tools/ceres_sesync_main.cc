@@ -11,6 +11,10 @@
 DEFINE_string(json, "", "Write a machine-readable JSON summary to this path.");
 DEFINE_string(output, "", "Write the resulting poses (g2o) to this path.");
 DEFINE_bool(verbose, false, "Log solver progress to stderr.");
+DEFINE_bool(strict_round_off, false,
+            "solve/certify: account rigorously for the round-off of the "
+            "certificate's translation block (SolverOptions::"
+            "strict_round_off).");
 DEFINE_int32(num_threads, 0,
              "solve, certify: threads for the O(m r) kernels (0: all cores).");
 

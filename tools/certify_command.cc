@@ -42,6 +42,8 @@ int RunCertify(const Args& args) {
   options.max_relative_suboptimality = FLAGS_max_relative_suboptimality;
   options.improve_if_not_certified = FLAGS_improve;
   options.num_threads = FLAGS_num_threads;
+  options.strict_round_off = FLAGS_strict_round_off;
+  options.solver_options.strict_round_off = FLAGS_strict_round_off;
   options.solver_options.num_threads = FLAGS_num_threads;
   Certificate certificate;
   if (!Certify(graph, poses, options, &certificate, &error)) {
@@ -63,6 +65,7 @@ int RunCertify(const Args& args) {
     json.Number("rotation_objective", certificate.rotation_objective);
     json.Number("lambda_min", certificate.lambda_min);
     json.Number("eta", certificate.eta);
+    json.Bool("strict_round_off", certificate.strict_round_off);
     json.Number("lower_bound", certificate.lower_bound);
     json.Number("suboptimality_bound", certificate.suboptimality_bound);
     json.Number("relative_suboptimality_bound",

@@ -18,6 +18,7 @@ DECLARE_string(json);
 DECLARE_string(output);
 DECLARE_bool(verbose);
 DECLARE_int32(num_threads);
+DECLARE_bool(strict_round_off);
 
 namespace ceres_sesync::tools {
 

@@ -77,6 +77,7 @@ int RunSolve(const Args& args) {
   options.max_time_s = FLAGS_max_time;
   options.verbose = FLAGS_verbose;
   options.num_threads = FLAGS_num_threads;
+  options.strict_round_off = FLAGS_strict_round_off;
   options.relative_preconditioned_gradient_tolerance = FLAGS_gradient_tolerance;
 
   const std::string& path = args[0];
@@ -127,6 +128,7 @@ int RunSolve(const Args& args) {
     json.Number("rounding_gap", summary.rounding_gap);
     json.Number("lambda_min", summary.lambda_min_estimate);
     json.Number("eta", summary.eta);
+    json.Bool("strict_round_off", summary.strict_round_off);
     json.Bool("certified", summary.certified());
     json.Int("rank", summary.final_rank);
     json.String("status", summary.StatusString());

@@ -25,7 +25,9 @@ namespace ceres_sesync::internal {
 
 class CertificateMatrix {
  public:
-  explicit CertificateMatrix(const SESyncProblem& problem);
+  // `strict_round_off`: see proven_shift().
+  explicit CertificateMatrix(const SESyncProblem& problem,
+                             bool strict_round_off = false);
 
   // Assembles and factorizes K_c for the d x dn multipliers Lambda. Returns
   // true iff the Cholesky factorization ran to completion. Without
@@ -34,7 +36,11 @@ class CertificateMatrix {
   bool Factorize(const Eigen::MatrixXd& Lambda, double c,
                  bool bound_backward_error = true);
 
-  // After a successful Factorize(): x = (S + cI)^{-1} y, y and x in R^{dn}.
+  // After a successful Factorize(): x = (S_mu + cI)^{-1} y, y and x in R^{dn},
+  // where S_mu = D - Lambda - Vbar^T (Lbar - mu I)^{-1} Vbar, mu =
+  // translation_shift() (0 after Factorize without bound_backward_error):
+  // S_mu <= S, within mu ||Lbar^{-1} Vbar||^2 of it (for eigenvalue
+  // estimates, not proofs).
   void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;
   // The same for the columns of Y (dn x k).
   void SolveShifted(const Eigen::MatrixXd& Y, Eigen::MatrixXd* X) const;
@@ -44,14 +50,27 @@ class CertificateMatrix {
   SparseCholeskyFactor ExtractFactor() { return factor_.ExtractFactor(); }
   int translation_size() const { return translation_size_; }
 
-  // After a successful Factorize(Lambda, c): c + delta, where delta bounds
-  // the factorization's backward error ||L L^T - P K_c P^T||_2 (see
-  // CholmodFactor::BackwardErrorBound), so K_c + delta I is proven positive
-  // semidefinite. Round-off in the translation block (rows of Lbar) reaches S
-  // amplified by ||Lbar^{-1} Vbar||^2; that worst case is not added (see
-  // certification.h, "Floating point").
+  // After a successful Factorize(Lambda, c): c + delta, with delta a bound
+  // on the factorization's floating-point backward error, computed row by
+  // row (CholmodFactor::BackwardErrorBound, plus the rounding of the
+  // assembly) and split into the translation rows (h) and the rotation rows.
+  //  - Default: delta = max over all rows. K_c + delta I is then proven
+  //    positive semidefinite; S + delta I follows to first order only:
+  //    round-off h in the translation block reaches S amplified by up to
+  //    ||Lbar^{-1} Vbar||^2, and that amplification is not added.
+  //  - strict_round_off: the factorized matrix is K_c with its translation
+  //    block shifted down to Lbar - mu I, mu >= h (adapted until it is), and
+  //    delta covers the rotation rows only. Then K_c + diag(0, delta I) is
+  //    proven positive semidefinite, hence its Schur complement
+  //    S + (c + delta) I, rigorously. The price: S_mu = S - (about)
+  //    mu Vbar^T Lbar^{-2} Vbar is what must be positive semidefinite, which
+  //    costs roughly mu * (mean squared distance of the poses from pose 0)
+  //    in lambda_min: large maps need much larger shifts.
   double proven_shift() const { return proven_shift_; }
   double backward_error() const { return backward_error_; }
+  // mu of the last factorization with bound_backward_error (see
+  // proven_shift()), else 0.
+  double translation_shift() const { return factorized_shift_; }
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }
@@ -60,11 +79,22 @@ class CertificateMatrix {
   bool supernodal() const { return factor_.IsSupernodal(); }
 
  private:
+  // K_ = K_c with Lambda, c and the translation block Lbar - mu I; sets
+  // *rotation_rounding to a bound on the rounding of the rotation rows.
+  void Assemble(const Eigen::MatrixXd& Lambda, double c, double mu,
+                double* rotation_rounding);
+
+  bool strict_round_off_ = false;
   int d_ = 0, n_ = 0, translation_size_ = 0, rotation_size_ = 0;
   SparseMatrix K_;                   // Lower triangle, pattern fixed.
   std::vector<double> base_values_;  // K_0 without Lambda.
   std::vector<int> block_entry_;     // Value index of each (i, a >= b).
   CholmodFactor factor_;
+  std::vector<int> translation_diagonal_;  // Value index of each Lbar_jj.
+  double max_translation_diagonal_ = 0;
+  // mu: the translation block of the factorized matrix is Lbar - mu I.
+  double translation_shift_ = 0;
+  double factorized_shift_ = 0;  // The mu of the current factor.
   double proven_shift_ = 0;
   double backward_error_ = 0;
 };

@@ -77,40 +77,68 @@ void MultiplyBySparse(const Eigen::MatrixXd& Y, const SparseMatrix& A,
 
 }  // namespace
 
-double CholmodFactor::BackwardErrorBound() {
-  cholmod_common* common = &cholmod();
-  cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, common);
-  CHECK(L != nullptr) << "out of memory copying the Cholesky factor";
-  // Simplicial, LL^T, packed: plain compressed columns.
-  cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0,
-                        /*to_packed=*/1, /*to_monotonic=*/1, L, common);
-  const int n = static_cast<int>(L->n);
-  const int* p = static_cast<const int*>(L->p);
-  const int* row = static_cast<const int*>(L->i);
-  const double* x = static_cast<const double*>(L->x);
+namespace {
+
+// Calls visit(row, column, value) for every stored entry of the lower
+// triangle of the LL^T factor L (permuted indices), in place: supernodal
+// (dense column blocks; entries above a block's diagonal are skipped) or
+// simplicial (column j: nz[j] entries from p[j], packed or not).
+template <typename Visit>
+void ForEachFactorEntry(const cholmod_factor& L, Visit visit) {
+  const double* x = static_cast<const double*>(L.x);
+  if (L.is_super) {
+    const auto* super = static_cast<const int*>(L.super);
+    const auto* pi = static_cast<const int*>(L.pi);
+    const auto* px = static_cast<const int*>(L.px);
+    const auto* s = static_cast<const int*>(L.s);
+    for (size_t k = 0; k < L.nsuper; ++k) {
+      const int rows = pi[k + 1] - pi[k];
+      for (int j = 0; j < super[k + 1] - super[k]; ++j) {
+        const double* column = x + px[k] + static_cast<size_t>(j) * rows;
+        for (int i = j; i < rows; ++i) {
+          visit(s[pi[k] + i], super[k] + j, column[i]);
+        }
+      }
+    }
+    return;
+  }
+  const auto* p = static_cast<const int*>(L.p);
+  const auto* nz = static_cast<const int*>(L.nz);
+  const auto* row = static_cast<const int*>(L.i);
+  for (size_t j = 0; j < L.n; ++j) {
+    const int end = p[j] + nz[j];
+    for (int k = p[j]; k < end; ++k) visit(row[k], static_cast<int>(j), x[k]);
+  }
+}
+
+}  // namespace
+
+void CholmodFactor::BackwardErrorBound(int split, double* head_bound,
+                                       double* tail_bound) {
+  CHECK(m_cholmodFactor != nullptr && m_factorizationIsOk);
+  const cholmod_factor& L = *m_cholmodFactor;
+  CHECK(L.is_ll) << "the backward error bound is for LL^T factors";
+  const int n = static_cast<int>(L.n);
   std::vector<double> column_sum(n, 0.0), v(n, 0.0);
   std::vector<int> row_count(n, 0);
-  for (int j = 0; j < n; ++j) {
-    for (int k = p[j]; k < p[j + 1]; ++k) {
-      column_sum[j] += std::abs(x[k]);
-      ++row_count[row[k]];
-    }
-  }
-  for (int j = 0; j < n; ++j) {
-    for (int k = p[j]; k < p[j + 1]; ++k) {
-      v[row[k]] += std::abs(x[k]) * column_sum[j];
-    }
-  }
-  cholmod_free_factor(&L, common);
-  // Entry (i, j) of L L^T sums at most min(k_i, k_j) products (k_i = nonzeros
-  // in row i), so row i of the error is bounded by gamma_{k_i + 1} v_i.
+  ForEachFactorEntry(L, [&](int i, int j, double value) {
+    column_sum[j] += std::abs(value);
+    ++row_count[i];
+  });
+  ForEachFactorEntry(L, [&](int i, int j, double value) {
+    v[i] += std::abs(value) * column_sum[j];
+  });
+  // Entry (i, j) of L L^T sums at most min(k_i, k_j) products (k_i = stored
+  // entries in row i), so row i of the error is bounded by gamma_{k_i + 1} v_i.
   const double unit_roundoff = std::numeric_limits<double>::epsilon() / 2;
-  double bound = 0;
+  const int* perm = static_cast<const int*>(L.Perm);
+  *head_bound = *tail_bound = 0;
   for (int i = 0; i < n; ++i) {
-    const double m = 4.0 * (row_count[i] + 1);
-    bound = std::max(bound, m * unit_roundoff / (1 - m * unit_roundoff) * v[i]);
+    const double m = row_count[i] + 1;
+    const double bound = m * unit_roundoff / (1 - m * unit_roundoff) * v[i];
+    double& side = (perm ? perm[i] : i) < split ? *head_bound : *tail_bound;
+    side = std::max(side, bound);
   }
-  return bound;
 }
 
 SparseCholeskyFactor CholmodFactor::ExtractFactor() {
@@ -242,7 +270,11 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
   lbar_factor_->factorize(Lbar_);
   ok_ = lbar_factor_->info() == Eigen::Success;
-  if (ok_) lbar_solver_ = lbar_factor_->ExtractFactor();
+  if (ok_) {
+    lbar_solver_ = lbar_factor_->ExtractFactor();
+    double unused;
+    lbar_factor_->BackwardErrorBound(n - 1, &lbar_backward_error_, &unused);
+  }
   LOG_IF(ERROR, !ok_) << "Cholesky factorization of the reduced translational "
                          "Laplacian failed";
 }

@@ -33,15 +33,17 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 class CholmodFactor
     : public Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> {
  public:
-  // After a successful factorization P A P^T = L L^T: a bound delta on
-  // ||L L^T - P A P^T||_2, so that A + delta I is positive semidefinite.
-  // Uses the componentwise bound |L L^T - P A P^T| <= gamma_{k+1} |L| |L^T|
-  // for Cholesky (Demmel 1989; Higham, "Accuracy and Stability of Numerical
-  // Algorithms", Thm. 10.5), applied row by row with k the number of nonzeros
-  // in the row of L and gamma widened by a factor 4 for blocked (supernodal)
-  // summation orders, and ||E||_2 <= ||E||_inf for the symmetric error E.
-  // O(nnz(L)) plus a copy of the factor.
-  double BackwardErrorBound();
+  // After a successful LL^T factorization P A P^T = L L^T + E: bounds on the
+  // floating-point backward error E such that
+  //   A + diag(head_bound I, tail_bound I) is positive semidefinite,
+  // with the head block the original indices < split and the tail the rest.
+  // Uses the componentwise bound |E| <= gamma_{k+1} |L| |L^T| for Cholesky
+  // (Demmel 1989; Higham, "Accuracy and Stability of Numerical Algorithms",
+  // Thm. 10.5) with k the number of stored entries in the row of L, gamma
+  // widened by a factor 4 for blocked (supernodal) summation orders, and
+  // -E <= diag(rho) for rho_i = sum_j |E_ij| (symmetric E, Gershgorin-type:
+  // 2 |x_i x_j| <= x_i^2 + x_j^2). O(nnz(L)), on the factor in place.
+  void BackwardErrorBound(int split, double* head_bound, double* tail_bound);
   // After a successful factorization: a copy of the factor for fast solves
   // with r x N right-hand sides.
   SparseCholeskyFactor ExtractFactor();
@@ -97,15 +99,19 @@ class SESyncProblem {
   // Lbar: L(W^tau) without its first row and column (lower triangle stored).
   const SparseMatrix& Lbar() const { return Lbar_; }
   // The rotational connection Laplacian L(G^rho) alone (dn x dn).
-  const SparseMatrix& RotationLaplacian() const {
-    return Lrho_;
-  }  // A fill-reducing ordering of the n poses (from the pattern of L(W^tau)):
+  const SparseMatrix& RotationLaplacian() const { return Lrho_; }
+  // A fill-reducing ordering of the n poses (from the pattern of L(W^tau)):
   // ordering[k] = pose eliminated k-th.
   const std::vector<int>& vertex_ordering() const { return vertex_ordering_; }
+  // A bound on the backward error of Lbar's Cholesky factorization
+  // (CholmodFactor::BackwardErrorBound): the scale of the round-off that
+  // factorizations of matrices containing Lbar make in its rows.
+  double lbar_backward_error() const { return lbar_backward_error_; }
 
  private:
   int d_ = 0, n_ = 0, num_threads_ = 1;
   bool ok_ = false;
+  double lbar_backward_error_ = 0;
   SparseMatrix D_, Lrho_, Vbar_, VbarT_, minus_Vbar_, Lbar_;
   std::unique_ptr<CholmodFactor> lbar_factor_;
   SparseCholeskyFactor lbar_solver_;  // The same factor, for MultiplyQ.
