@@ -184,7 +184,10 @@ void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
                       ? Eigen::CholmodSimplicialLLt
                       : Eigen::CholmodSupernodalLLt);
   cholmod_common& common = factor->cholmod();
-  if (layout == CholmodLayout::kAutomatic) common.supernodal = CHOLMOD_AUTO;
+  if (layout == CholmodLayout::kAutomatic) {
+    common.supernodal = CHOLMOD_AUTO;
+    common.supernodal_switch = kSupernodalSwitch;
+  }
   // A simplicial factorization is computed as LL^T (not LDL^T) iff final_ll.
   common.final_ll = 1;
   common.print = 0;

@@ -59,14 +59,17 @@ class CholmodFactor
   bool IsSupernodal() const;
 };
 
-// How CHOLMOD organizes the factor. Simplicial: fast for the very sparse
-// factors of 2D graphs and for repeated solves; supernodal: dense BLAS
-// kernels, fast for the larger fill of 3D graphs; automatic: CHOLMOD chooses
-// after the symbolic analysis (supernodal when flops / nnz(L) >= 40). On the
-// certificate matrix of the benchmark datasets automatic picks the faster of
-// the two (e.g. CSAIL factorization 0.4 vs 1.8 ms simplicial vs supernodal,
-// torus3D 121 vs 279 ms supernodal vs simplicial).
+// How CHOLMOD organizes the factor. Simplicial: fast for sparse factors and
+// for repeated solves; supernodal: dense BLAS kernels, fast only for heavy
+// fill; automatic: supernodal when flops / nnz(L) >= kSupernodalSwitch after
+// the symbolic analysis. Measured on the certificate matrix of the benchmark
+// datasets (CHOLMOD 3 with Debian's ATLAS, one thread), simplicial vs
+// supernodal factorization: city10000 (flops / nnz(L) = 84) 38 vs 75 ms,
+// cubicle (152) 85 vs 120 ms, sphere2500 (170) 38 vs 55 ms, torus3D (265)
+// 146 vs 118 ms; CHOLMOD's own switch (40) would pick supernodal for the
+// first three.
 enum class CholmodLayout { kSimplicial, kSupernodal, kAutomatic };
+constexpr double kSupernodalSwitch = 200;
 
 // Sets a true LL^T factorization in every layout (which fails on matrices
 // that are not positive definite, unlike LDL^T) and silences CHOLMOD's own
