@@ -8,23 +8,10 @@
 #include "Eigen/LU"
 #include "Eigen/SVD"
 #include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/internal/rounding.h"
 
 namespace ceres_sesync {
 namespace {
-
-// Nearest rotation (Frobenius) to a d x d matrix: U diag(1, .., det(U V^T))
-// V^T from its SVD.
-template <int kD>
-Eigen::Matrix<double, kD, kD> ProjectToRotation(
-    const Eigen::Matrix<double, kD, kD>& M) {
-  Eigen::JacobiSVD<Eigen::Matrix<double, kD, kD>> svd(
-      M, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix<double, kD, 1> s = Eigen::Matrix<double, kD, 1>::Ones();
-  s(kD - 1) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0
-                  ? -1.0
-                  : 1.0;
-  return svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
-}
 
 std::string Num(double v) { return std::to_string(v); }
 
@@ -62,7 +49,7 @@ bool PoseToIsometryImpl(
     return false;
   }
   transform->setIdentity();
-  transform->linear() = ProjectToRotation<kD>(pose.R);
+  transform->linear() = internal::ProjectToRotation<kD>(pose.R);
   transform->translation() = pose.t;
   return true;
 }
@@ -242,7 +229,7 @@ bool PoseToQuaternionTranslation(const Pose& pose, Eigen::Quaterniond* q,
           pose, 3, "PoseToQuaternionTranslation: the pose", error)) {
     return false;
   }
-  const Eigen::Matrix3d R = ProjectToRotation<3>(pose.R);
+  const Eigen::Matrix3d R = internal::ProjectToRotation<3>(pose.R);
   Eigen::Quaterniond result(R);
   result.normalize();
   if (result.w() < 0) result.coeffs() *= -1;

@@ -7,6 +7,12 @@
 namespace ceres_sesync::internal {
 
 Eigen::MatrixXd ProjectToRotation(const Eigen::MatrixXd& M) {
+  if (M.rows() == 2 && M.cols() == 2) {
+    return ProjectToRotation<2>(Eigen::Matrix2d(M));
+  }
+  if (M.rows() == 3 && M.cols() == 3) {
+    return ProjectToRotation<3>(Eigen::Matrix3d(M));
+  }
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(
       M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::MatrixXd U = svd.matrixU();
@@ -19,7 +25,15 @@ Eigen::MatrixXd ProjectToRotation(const Eigen::MatrixXd& M) {
 Eigen::MatrixXd ProjectBlocksToRotations(const Eigen::MatrixXd& X, int d) {
   Eigen::MatrixXd R(X.rows(), X.cols());
   for (int i = 0; i < X.cols() / d; ++i) {
-    R.middleCols(d * i, d) = ProjectToRotation(X.middleCols(d * i, d));
+    if (d == 2) {
+      R.middleCols<2>(2 * i) =
+          ProjectToRotation<2>(Eigen::Matrix2d(X.middleCols<2>(2 * i)));
+    } else if (d == 3) {
+      R.middleCols<3>(3 * i) =
+          ProjectToRotation<3>(Eigen::Matrix3d(X.middleCols<3>(3 * i)));
+    } else {
+      R.middleCols(d * i, d) = ProjectToRotation(X.middleCols(d * i, d));
+    }
   }
   return R;
 }
