@@ -30,13 +30,17 @@
 //
 // Floating point: a Cholesky factorization that completes proves K + E
 // positive definite for the computed factor's backward error E. eta includes
-// a rigorous worst-case bound on E (componentwise bound of Demmel 1989,
-// Higham Thm. 10.5, widened 4x for blocked summation, applied row by row),
-// and the factorized matrix has its translation block lowered by at least the
-// bound of the translation rows (Lbar - mu I), so that the proof carries over
-// exactly to S + eta I with nothing amplified through Lbar^{-1}. The proof is
-// for the data matrices as computed from the file (their own round-off,
-// ~1e-16 relative per entry, is not propagated).
+// a rigorous worst-case bound on E (componentwise bound of Demmel 1989 and
+// Higham Thm. 10.3, any summation order, row by row, plus the rounding of the
+// assembly). One step is first order by default: the bound of K's
+// translation rows reaches S amplified by up to ||Lbar^{-1} Vbar||^2, which
+// is not added. With strict_round_off the factorized matrix has its
+// translation block lowered by at least that bound (Lbar - mu I), so the
+// proof carries over exactly to S + eta I; on large maps (poses far from
+// pose 0) that needs much larger shifts and may not certify at all (see the
+// README). Either way the proof is for the data matrices as computed from
+// the file (their own round-off, ~1e-16 relative per entry, is not
+// propagated).
 // Local minima from local search have lambda_min(S) many orders of magnitude
 // below these allowances, so they are never certified.
 

@@ -103,6 +103,82 @@ TEST(ConfigureCholmod, EveryLayoutRejectsIndefiniteMatrices) {
   }
 }
 
+// Access to the CHOLMOD factor, to compute the true residual in the test.
+class InspectableFactor : public CholmodFactor {
+ public:
+  const cholmod_factor& raw() const { return *m_cholmodFactor; }
+};
+
+// BackwardErrorBound (in place, simplicial or supernodal) bounds the true
+// backward error: for every row i, sum_j |(L L^T - P A P^T)_ij| (computed in
+// long double from the factor converted by CHOLMOD itself) <= the bound of
+// the block that holds row i. Both layouts bound the same matrix alike, and
+// the split assigns rows by their original index.
+TEST(CholmodFactor, BackwardErrorBoundCoversTheTrueResidual) {
+  const int n = 300, split = 120;
+  const SparseMatrix A = RandomSpd(n, 2500, 17);
+  const Eigen::MatrixXd dense =
+      Eigen::MatrixXd(A).selfadjointView<Eigen::Lower>();
+  double bounds[2][2];  // [layout][head, tail]
+  int layout_index = 0;
+  for (CholmodLayout layout :
+       {CholmodLayout::kSimplicial, CholmodLayout::kSupernodal}) {
+    InspectableFactor factor;
+    ConfigureCholmod(layout, &factor);
+    factor.compute(A);
+    ASSERT_EQ(factor.info(), Eigen::Success);
+    EXPECT_EQ(factor.IsSupernodal(), layout == CholmodLayout::kSupernodal);
+    double head = 0, tail = 0;
+    factor.BackwardErrorBound(split, &head, &tail);
+    bounds[layout_index][0] = head;
+    bounds[layout_index][1] = tail;
+    ++layout_index;
+    double all = 0, none = 0, unused = 0;
+    factor.BackwardErrorBound(n, &all, &none);
+    EXPECT_EQ(none, 0.0);
+    EXPECT_EQ(all, std::max(head, tail));
+    factor.BackwardErrorBound(0, &unused, &all);
+    EXPECT_EQ(unused, 0.0);
+    EXPECT_EQ(all, std::max(head, tail));
+
+    // Dense L from a simplicial packed copy (CHOLMOD's own conversion).
+    cholmod_common* common = &factor.cholmod();
+    cholmod_factor* copy =
+        cholmod_copy_factor(const_cast<cholmod_factor*>(&factor.raw()), common);
+    ASSERT_TRUE(cholmod_change_factor(CHOLMOD_REAL, 1, 0, 1, 1, copy, common));
+    Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic> L =
+        Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>::Zero(n, n);
+    const int* p = static_cast<const int*>(copy->p);
+    const int* row = static_cast<const int*>(copy->i);
+    const double* x = static_cast<const double*>(copy->x);
+    for (int j = 0; j < n; ++j) {
+      for (int k = p[j]; k < p[j + 1]; ++k) L(row[k], j) = x[k];
+    }
+    const int* perm = static_cast<const int*>(copy->Perm);
+    Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic> PAP(n, n);
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) PAP(a, b) = dense(perm[a], perm[b]);
+    }
+    const auto E = (L * L.transpose() - PAP).eval();
+    double worst_ratio = 0;
+    for (int a = 0; a < n; ++a) {
+      const double row_error = static_cast<double>(E.row(a).cwiseAbs().sum());
+      const double bound = perm[a] < split ? head : tail;
+      EXPECT_LE(row_error, bound)
+          << "row " << a << " layout " << static_cast<int>(layout);
+      worst_ratio = std::max(worst_ratio, row_error / bound);
+    }
+    EXPECT_GT(worst_ratio, 0.0);  // The residual is really measured.
+    cholmod_free_factor(&copy, common);
+  }
+  // Same matrix, same bound formula, different stored patterns (supernodes
+  // store some zeros): the same order of magnitude.
+  for (int side = 0; side < 2; ++side) {
+    EXPECT_GT(bounds[1][side], 0.5 * bounds[0][side]);
+    EXPECT_LT(bounds[1][side], 4 * bounds[0][side]);
+  }
+}
+
 // Rows are split over threads with unchanged arithmetic: bitwise identical
 // results (the matrix is large enough to pass the parallel work threshold).
 TEST(SparseCholeskyFactor, ThreadsGiveIdenticalResults) {

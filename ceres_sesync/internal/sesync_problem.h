@@ -39,8 +39,9 @@ class CholmodFactor
   // with the head block the original indices < split and the tail the rest.
   // Uses the componentwise bound |E| <= gamma_{k+1} |L| |L^T| for Cholesky
   // (Demmel 1989; Higham, "Accuracy and Stability of Numerical Algorithms",
-  // Thm. 10.5) with k the number of stored entries in the row of L, gamma
-  // widened by a factor 4 for blocked (supernodal) summation orders, and
+  // Thm. 10.3) with k the number of stored entries in the row of L; the
+  // bound holds for every order of summation (Higham Lemma 8.4), so blocked
+  // supernodal kernels need no widening; and
   // -E <= diag(rho) for rho_i = sum_j |E_ij| (symmetric E, Gershgorin-type:
   // 2 |x_i x_j| <= x_i^2 + x_j^2). O(nnz(L)), on the factor in place.
   void BackwardErrorBound(int split, double* head_bound, double* tail_bound);
