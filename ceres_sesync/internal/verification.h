@@ -25,6 +25,10 @@ struct VerificationResult {
   double direction_curvature = 0;
   // The eigensolver did not produce a direction of negative curvature.
   bool eigensolver_failed = false;
+  // S + (tr(Lambda) / dn) I is not positive definite: every provable shift
+  // gives the vacuous bound tr(Lambda) - eta d n < 0, so none was sought
+  // (eta = +inf) and the direction is from Lanczos on S (tolerance 1e-3).
+  bool vacuous_bound = false;
   int factorizations = 0;
 };
 
@@ -37,6 +41,9 @@ Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
 // lambda_max(Lambda) (where S + cI is positive definite since Q is PSD).
 // Certified iff the smallest proven shift is <= eta_max; otherwise a
 // negative-curvature direction is computed by shift-and-invert Lanczos.
+// Shortcut for poor candidates: when S + (tr(Lambda) / dn) I is not positive
+// definite either (one more factorization), no shift can give a positive
+// bound; the direction then comes from Lanczos on S (vacuous_bound).
 VerificationResult VerifyCertificate(const SESyncProblem& problem,
                                      const Eigen::MatrixXd& Lambda,
                                      double eta_target, double eta_max,
