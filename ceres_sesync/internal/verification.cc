@@ -53,11 +53,13 @@ class CertificateOperator {
 };
 
 // Fast detection of clearly negative curvature: a short Lanczos run for the
-// smallest eigenvalue of S itself. Returns true with a unit vector v and its
-// Rayleigh quotient v^T S v < 0 when it converged to a negative eigenvalue.
+// smallest eigenvalue of S itself. Returns true, with result->direction a
+// unit vector v, result->direction_curvature = v^T S v < 0 and
+// result->lambda_min_estimate the same Rayleigh quotient (>= lambda_min(S)),
+// when it converged to a negative eigenvalue; else leaves *result alone.
 bool FindNegativeCurvature(const SESyncProblem& problem,
-                           const Eigen::MatrixXd& Lambda, Eigen::VectorXd* v,
-                           double* curvature) {
+                           const Eigen::MatrixXd& Lambda,
+                           VerificationResult* result) {
   CertificateOperator op(&problem, &Lambda);
   const int dim = static_cast<int>(op.rows());
   if (dim < 3) return false;
@@ -65,9 +67,13 @@ bool FindNegativeCurvature(const SESyncProblem& problem,
   eigs.init();
   eigs.compute(Spectra::SortRule::SmallestAlge, /*maxit=*/3, /*tol=*/1e-3);
   if (eigs.info() != Spectra::CompInfo::Successful) return false;
-  *v = eigs.eigenvectors().col(0).normalized();
-  *curvature = v->dot(MultiplyCertificate(problem, Lambda, *v));
-  return *curvature < 0;
+  const Eigen::VectorXd v = eigs.eigenvectors().col(0).normalized();
+  const double curvature = v.dot(MultiplyCertificate(problem, Lambda, v));
+  if (!(curvature < 0)) return false;
+  result->direction = v;
+  result->direction_curvature = curvature;
+  result->lambda_min_estimate = curvature;
+  return true;
 }
 
 double MaxBlockEigenvalue(const Eigen::MatrixXd& Lambda, int d) {
@@ -111,23 +117,17 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // c >= c_vacuous gives the bound tr(Lambda) - c d n <= 0, so if S +
   // c_vacuous I is indefinite the bracketing below (often ten factorizations
   // that fail late) could only prove a vacuous bound: find the witness
-  // directly (e.g. cubicle's file guess: 0.77 -> 0.2 s).
+  // directly (e.g. cubicle's file guess: 0.77 -> 0.26 s).
   double trace = 0;
   for (int i = 0; i < Lambda.cols(); ++i) trace += Lambda(i % d, i);
   const double c_vacuous = trace / Lambda.cols();
   if (c_vacuous > std::max(eta_target, eta_max)) {
     ++result.factorizations;
-    if (!matrix->Factorize(Lambda, c_vacuous)) {
-      Eigen::VectorXd v;
-      double curvature = 0;
-      if (FindNegativeCurvature(problem, Lambda, &v, &curvature)) {
-        result.direction = v;
-        result.direction_curvature = curvature;
-        result.lambda_min_estimate = curvature;  // >= lambda_min(S).
-        result.eta = std::numeric_limits<double>::infinity();
-        result.vacuous_bound = true;
-        return result;
-      }
+    if (!matrix->Factorize(Lambda, c_vacuous) &&
+        FindNegativeCurvature(problem, Lambda, &result)) {
+      result.eta = std::numeric_limits<double>::infinity();
+      result.vacuous_bound = true;
+      return result;
     }
   }
   // Bracket lambda_min(S) from below: S + cI is PD for c > lambda_max(Lambda).
@@ -139,16 +139,11 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       // lambda_min(S) < -256 eta_target: usually clear negative curvature
       // (a saddle or a poor candidate), which Lanczos on S finds in a few
       // dozen products with Q; jump the shift just past it. Only worth it
-      // when factorizations are expensive (supernodal: 3D graphs, e.g.
-      // cubicle's file guess 0.54 -> 0.34 s, sphere2500 0.32 -> 0.15 s); the
-      // sparse 2D factorizations are cheaper than the Lanczos run.
-      Eigen::VectorXd v;
-      double curvature = 0;
-      if (FindNegativeCurvature(problem, Lambda, &v, &curvature)) {
-        result.direction = v;
-        result.direction_curvature = curvature;
-        result.lambda_min_estimate = curvature;  // >= lambda_min(S).
-        c = std::max(c, std::min(-1.1 * curvature, c_upper) / 16);
+      // when factorizations are expensive (supernodal: heavy fill, e.g.
+      // torus3D); sparser factorizations are cheaper than the Lanczos run.
+      if (FindNegativeCurvature(problem, Lambda, &result)) {
+        c = std::max(c,
+                     std::min(-1.1 * result.direction_curvature, c_upper) / 16);
       }
     }
     c = std::min(16 * c, c_upper);
