@@ -1,7 +1,8 @@
 // Benchmark: SE-Sync versus Ceres local search on the standard pose-graph
 // datasets (Rosen et al., IJRR 2019, Section 6.2, Tables 1-2).
 //
-//   bench [--quick] [--repeats N] [--out_dir DIR] [--ceres_max_time S]
+//   bench [--quick] [--repeats N] [--min_time S] [--out_dir DIR]
+//         [--ceres_max_time S]
 //         [--poses_dir DIR] [--sesync_only] [--methods LIST]
 //         [--[no]lbfgs] [--lbfgs_max_time S] [--lbfgs_repeats N] [files...]
 //
@@ -58,6 +59,11 @@
 DEFINE_bool(quick, false,
             "Only tinyGrid3D, smallGrid3D, CSAIL and intel, one repeat.");
 DEFINE_int32(repeats, 3, "Timed repeats per method (min and median kept).");
+DEFINE_double(min_time, 1.0,
+              "SE-Sync, Certify, the chordal initialization and Ceres from "
+              "it repeat beyond --repeats until their runs add up to this "
+              "many seconds (at most 100 runs): the minimum over more runs "
+              "filters machine noise on the millisecond-scale datasets.");
 DEFINE_int32(num_threads, 1,
              "Threads for every method alike: SolverOptions::num_threads, "
              "CertifyOptions::num_threads and Ceres's num_threads.");
@@ -98,6 +104,18 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Whether to run repeat number `done` (0-based) given the time `spent` so
+// far: at least `repeats` runs, more until --min_time (100 runs at most).
+bool Again(int done, int repeats, double spent, bool extend = true) {
+  return done < repeats || (extend && spent < FLAGS_min_time && done < 100);
+}
+
+double Sum(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return s;
 }
 
 double Median(std::vector<double> v) {
@@ -221,7 +239,7 @@ Row RunCeres(const PoseGraph& graph, const std::string& dataset,
   options.num_threads = FLAGS_num_threads;
   Poses result;
   CeresBaselineSummary summary;
-  for (int r = 0; r < repeats; ++r) {
+  for (int r = 0; Again(r, repeats, Sum(row.times), init == "chordal"); ++r) {
     std::string error;
     const auto start = Clock::now();
     if (!SolveWithCeres(graph, initial, options, &result, &summary, &error)) {
@@ -273,14 +291,15 @@ std::string ShortTermination(const std::string& termination) {
 // if the graph is invalid.
 bool RunSESync(const PoseGraph& graph, const std::string& dataset,
                const std::string& method, const SolverOptions& options,
-               int repeats, Row* row, Stages* stage, Poses* poses) {
+               int repeats, bool extend, Row* row, Stages* stage,
+               Poses* poses) {
   row->dataset = stage->dataset = dataset;
   row->method = stage->method = method;
   row->n = stage->n = graph.num_poses;
   row->m = stage->m = static_cast<int>(graph.measurements.size());
   row->init = "chordal";
   stage->d = graph.dimension;
-  for (int r = 0; r < repeats; ++r) {
+  for (int r = 0; Again(r, repeats, Sum(row->times), extend); ++r) {
     SolverSummary summary;
     const auto start = Clock::now();
     *poses = Solve(graph, options, &summary);
@@ -359,8 +378,8 @@ bool BenchDataset(const std::string& path, int repeats,
     Poses sesync_poses;
     SolverOptions sesync_options;
     sesync_options.num_threads = FLAGS_num_threads;
-    if (!RunSESync(graph, dataset, "SE-Sync", sesync_options, repeats, &sesync,
-                   &stage, &sesync_poses)) {
+    if (!RunSESync(graph, dataset, "SE-Sync", sesync_options, repeats,
+                   /*extend=*/true, &sesync, &stage, &sesync_poses)) {
       return false;
     }
     rows->push_back(sesync);
@@ -385,7 +404,7 @@ bool BenchDataset(const std::string& path, int repeats,
     row.method = "Certify";
     row.init = "sesync";
     row.objective = sesync.objective;
-    for (int r = 0; r < repeats; ++r) {
+    for (int r = 0; Again(r, repeats, Sum(row.times)); ++r) {
       double t = NAN;
       CertifyInto(graph, sesync_poses, &row, &t);
       if (!std::isnan(t)) row.times.push_back(t);
@@ -405,8 +424,8 @@ bool BenchDataset(const std::string& path, int repeats,
     Stages stage;
     Poses poses;
     if (!RunSESync(graph, dataset, "SE-Sync (Ceres LBFGS)", options,
-                   std::max(1, std::min(repeats, FLAGS_lbfgs_repeats)), &row,
-                   &stage, &poses)) {
+                   std::max(1, std::min(repeats, FLAGS_lbfgs_repeats)),
+                   /*extend=*/false, &row, &stage, &poses)) {
       return false;
     }
     rows->push_back(row);
@@ -439,7 +458,7 @@ bool BenchDataset(const std::string& path, int repeats,
   double chordal_time = 0;
   {
     std::vector<double> t;
-    for (int r = 0; r < repeats; ++r) {
+    for (int r = 0; Again(r, repeats, Sum(t)); ++r) {
       const auto start = Clock::now();
       if (!ChordalInitialization(graph, &chordal, &error)) {
         std::fprintf(stderr, "bench: %s: chordal: %s\n", path.c_str(),
@@ -639,9 +658,11 @@ int main(int argc, char** argv) {
     }
     md << ".\n";
   }
-  md << "Repeats: " << repeats << " (runs from the file's initial guess: "
+  md << "Repeats: at least " << repeats << ", more until " << FLAGS_min_time
+     << " s per method and dataset (SE-Sync, Certify, chordal initialization "
+        "and Ceres from it; at most 100); runs from the file's initial guess: "
      << std::max(1, std::min(repeats, FLAGS_odometry_repeats))
-     << "); Ceres time limit " << FLAGS_ceres_max_time
+     << "; Ceres time limit " << FLAGS_ceres_max_time
      << " s. Peak RSS of the whole run: " << Fmt("%.0f", PeakRssMiB())
      << " MiB.\n";
   std::fputs(md.str().c_str(), stdout);
