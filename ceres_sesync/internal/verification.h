@@ -26,8 +26,7 @@ struct VerificationResult {
   // The eigensolver did not produce a direction of negative curvature.
   bool eigensolver_failed = false;
   // S + (tr(Lambda) / dn) I is not positive definite: every provable shift
-  // gives the vacuous bound tr(Lambda) - eta d n < 0, so none was sought
-  // (eta = +inf) and the direction is from Lanczos on S (tolerance 1e-3).
+  // gives the vacuous bound tr(Lambda) - eta d n < 0 (eta > tr(Lambda) / dn).
   bool vacuous_bound = false;
   int factorizations = 0;
 };
@@ -41,9 +40,10 @@ Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
 // lambda_max(Lambda) (where S + cI is positive definite since Q is PSD).
 // Certified iff the smallest proven shift is <= eta_max; otherwise a
 // negative-curvature direction is computed by shift-and-invert Lanczos.
-// Shortcut for poor candidates: when S + (tr(Lambda) / dn) I is not positive
-// definite either (one more factorization), no shift can give a positive
-// bound; the direction then comes from Lanczos on S (vacuous_bound).
+// Poor candidates: one factorization at c = tr(Lambda) / dn (above which
+// every bound is vacuous) caps the bracketing there when it succeeds; when it
+// fails (vacuous_bound), the witness comes from Lanczos on S (eta = +inf) or,
+// if that does not converge, the bracketing starts there.
 VerificationResult VerifyCertificate(const SESyncProblem& problem,
                                      const Eigen::MatrixXd& Lambda,
                                      double eta_target, double eta_max,
