@@ -142,12 +142,13 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     }
   }
   for (int step = 0; c < c_upper; ++step) {
-    if (step == 2 && matrix->supernodal()) {
+    if (step == 2 && matrix->supernodal() && !result.vacuous_bound) {
       // lambda_min(S) < -256 eta_target: usually clear negative curvature
       // (a saddle or a poor candidate), which Lanczos on S finds in a few
       // dozen products with Q; jump the shift just past it. Only worth it
       // when factorizations are expensive (supernodal: heavy fill, e.g.
       // torus3D); sparser factorizations are cheaper than the Lanczos run.
+      // (Not again after the poor-candidate test: it already ran, and failed.)
       if (FindNegativeCurvature(problem, Lambda, &result)) {
         c = std::max(c,
                      std::min(-1.1 * result.direction_curvature, c_upper) / 16);
