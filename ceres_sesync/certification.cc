@@ -64,8 +64,7 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
     Eigen::MatrixXd RQ;
     problem.MultiplyQ(R, &RQ);
     const Eigen::MatrixXd Lambda = SymBlockDiagProduct(RQ, R, d);
-    double trace = 0;
-    for (int i = 0; i < d * n; ++i) trace += Lambda(i % d, i);
+    const double trace = internal::BlockDiagonalTrace(Lambda, d);
     c.rotation_objective = trace;
     // Largest eta for which the bound can still meet the tolerance:
     // objective - (trace - eta d n) <= tol (trace - eta d n).

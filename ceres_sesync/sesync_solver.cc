@@ -228,8 +228,7 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
     }
     level.optimize_time_s = Seconds(t);
     // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
-    sdp_value = 0;
-    for (int i = 0; i < d * n; ++i) sdp_value += cost.Lambda()(i % d, i);
+    sdp_value = internal::BlockDiagonalTrace(cost.Lambda(), d);
     level.sdp_value = sdp_value;
 
     // Verify.

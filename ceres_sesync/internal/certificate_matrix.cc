@@ -38,6 +38,7 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem,
       n_(problem.num_poses()),
       translation_size_(problem.num_poses() - 1),
       rotation_size_(problem.dimension() * problem.num_poses()) {
+  CHECK_LE(d_, 3);  // Assemble's row sums.
   const int t0 = translation_size_, d = d_;
   std::vector<Triplet> triplets;
   const SparseMatrix& L = problem.Lbar();
@@ -98,7 +99,7 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem,
   }
   // The translation rows of K's factor carry round-off of the size of
   // Lbar's own factorization (4-25x its bound on the benchmark datasets).
-  translation_shift_ = 64 * problem.lbar_backward_error();
+  if (strict_round_off_) translation_shift_ = 64 * problem.LbarBackwardError();
   ConfigureCholmod(CholmodLayout::kAutomatic, &factor_);
   factor_.AnalyzePatternWithOrdering(K_, BlockOrdering(problem));
 }
@@ -132,7 +133,6 @@ void CertificateMatrix::Assemble(const Eigen::MatrixXd& Lambda, double c,
 
 bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c,
                                   bool bound_backward_error) {
-  CHECK_LE(d_, 3);
   if (!bound_backward_error) {
     double unused;
     Assemble(Lambda, c, 0, &unused);

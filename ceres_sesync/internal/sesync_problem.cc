@@ -273,11 +273,7 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
   lbar_factor_->factorize(Lbar_);
   ok_ = lbar_factor_->info() == Eigen::Success;
-  if (ok_) {
-    lbar_solver_ = lbar_factor_->ExtractFactor();
-    double unused;
-    lbar_factor_->BackwardErrorBound(n - 1, &lbar_backward_error_, &unused);
-  }
+  if (ok_) lbar_solver_ = lbar_factor_->ExtractFactor();
   LOG_IF(ERROR, !ok_) << "Cholesky factorization of the reduced translational "
                          "Laplacian failed";
 }
@@ -290,6 +286,19 @@ void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,
   MultiplyBySparse(Y, VbarT_, /*accumulate=*/false, num_threads_, &P);
   lbar_solver_.SolveRows(P, &Z, num_threads_);
   MultiplyBySparse(Z, minus_Vbar_, /*accumulate=*/true, num_threads_, YQ);
+}
+
+double SESyncProblem::LbarBackwardError() const {
+  if (n_ == 1) return 0;
+  double bound = 0, unused = 0;
+  lbar_factor_->BackwardErrorBound(n_ - 1, &bound, &unused);
+  return bound;
+}
+
+double BlockDiagonalTrace(const Eigen::MatrixXd& Lambda, int d) {
+  double trace = 0;
+  for (int i = 0; i < Lambda.cols(); ++i) trace += Lambda(i % d, i);
+  return trace;
 }
 
 Eigen::MatrixXd SESyncProblem::RecoverTranslations(

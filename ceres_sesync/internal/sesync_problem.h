@@ -109,18 +109,21 @@ class SESyncProblem {
   const std::vector<int>& vertex_ordering() const { return vertex_ordering_; }
   // A bound on the backward error of Lbar's Cholesky factorization
   // (CholmodFactor::BackwardErrorBound): the scale of the round-off that
-  // factorizations of matrices containing Lbar make in its rows.
-  double lbar_backward_error() const { return lbar_backward_error_; }
+  // factorizations of matrices containing Lbar make in its rows. O(nnz) per
+  // call.
+  double LbarBackwardError() const;
 
  private:
   int d_ = 0, n_ = 0, num_threads_ = 1;
   bool ok_ = false;
-  double lbar_backward_error_ = 0;
   SparseMatrix D_, Lrho_, Vbar_, VbarT_, minus_Vbar_, Lbar_;
   std::unique_ptr<CholmodFactor> lbar_factor_;
   SparseCholeskyFactor lbar_solver_;  // The same factor, for MultiplyQ.
   std::vector<int> vertex_ordering_;
 };
+
+// tr(Lambda) = sum_i tr(Lambda_i) for the d x d blocks of Lambda (d x dn).
+double BlockDiagonalTrace(const Eigen::MatrixXd& Lambda, int d);
 
 // out_i = V_i * Lambda_i for the d x d blocks Lambda (d x dn) and the r x d
 // blocks V_i of V (r x dn).

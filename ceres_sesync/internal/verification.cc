@@ -125,9 +125,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // else the bracketing starts at c_vacuous instead of eta_target (skipping
   // up to ten factorizations that fail late). If it succeeds, the
   // bracketing stops there at the latest.
-  double trace = 0;
-  for (int i = 0; i < Lambda.cols(); ++i) trace += Lambda(i % d, i);
-  const double c_vacuous = trace / Lambda.cols();
+  const double c_vacuous = BlockDiagonalTrace(Lambda, d) / Lambda.cols();
   if (c_vacuous > std::max(eta_target, eta_max) && c_vacuous < c_upper) {
     ++result.factorizations;
     if (matrix->Factorize(Lambda, c_vacuous)) {
