@@ -1,0 +1,392 @@
+#include "ceres_sesync/internal/staircase.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "ceres_sesync/internal/ceres_local_solver.h"
+#include "ceres_sesync/internal/chordal.h"
+#include "ceres_sesync/internal/parallel.h"
+#include "ceres_sesync/internal/rounding.h"
+#include "ceres_sesync/riemannian_trust_region.h"
+#include "ceres_sesync/stiefel_manifold.h"
+#include "glog/logging.h"
+
+namespace ceres_sesync::internal {
+namespace {
+
+PreconditionerType ToInternal(SolverOptions::Preconditioner p) {
+  switch (p) {
+    case SolverOptions::Preconditioner::kNone:
+      return PreconditionerType::kNone;
+    case SolverOptions::Preconditioner::kBlockJacobi:
+      return PreconditionerType::kBlockJacobi;
+    case SolverOptions::Preconditioner::kSparseCholesky:
+      return PreconditionerType::kSparseCholesky;
+    case SolverOptions::Preconditioner::kRegularizedQ:
+      return PreconditionerType::kRegularizedQ;
+  }
+  return PreconditionerType::kNone;
+}
+
+double MaxDiagonal(const SparseMatrix& A) {
+  double m = 0;
+  for (int k = 0; k < A.rows(); ++k) m = std::max(m, A.coeff(k, k));
+  return m;
+}
+
+RiemannianTrustRegionOptions TrustRegionOptions(const SolverOptions& options) {
+  RiemannianTrustRegionOptions rtr;
+  rtr.max_iterations = options.max_iterations;
+  rtr.max_inner_iterations = options.max_inner_iterations;
+  rtr.gradient_tolerance = 0;
+  rtr.relative_decrease_tolerance = options.relative_decrease_tolerance;
+  return rtr;
+}
+
+}  // namespace
+
+Poses ToPosesInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
+                     const Eigen::MatrixXd& T) {
+  const int d = graph.dimension, n = graph.num_poses;
+  const int g = graph.fixed_pose >= 0 ? graph.fixed_pose : 0;
+  Eigen::MatrixXd RG = Eigen::MatrixXd::Identity(d, d);
+  Eigen::VectorXd tG = Eigen::VectorXd::Zero(d);
+  if (!graph.initial_poses.empty()) {
+    RG = graph.initial_poses[g].R;
+    tG = graph.initial_poses[g].t;
+  }
+  const Eigen::MatrixXd A = RG * R.middleCols(d * g, d).transpose();
+  const Eigen::VectorXd tg = T.col(g);
+  Poses poses(n);
+  for (int i = 0; i < n; ++i) {
+    poses[i].R = ProjectToRotation(A * R.middleCols(d * i, d));
+    poses[i].t = A * (T.col(i) - tg) + tG;
+  }
+  return poses;
+}
+
+Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
+                     SolverSummary* summary, Clock::time_point start)
+    : graph_(graph), options_(options), summary_(summary), start_(start) {
+  *summary_ = SolverSummary();
+  SolverSummary& s = *summary_;
+  s.lambda_min_estimate = std::numeric_limits<double>::quiet_NaN();
+  s.dimension = graph.dimension;
+  s.num_poses = graph.num_poses;
+  s.num_measurements = static_cast<int>(graph.measurements.size());
+  s.strict_round_off = options.strict_round_off;
+  if (!ValidatePoseGraph(graph, &s.message)) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    return;
+  }
+  d_ = graph.dimension;
+  n_ = graph.num_poses;
+  r0_ = options.initial_rank > 0 ? options.initial_rank : d_ + 2;
+  if (r0_ < d_ + 1 || options.max_rank < r0_) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message = "initial_rank must be >= d + 1 and <= max_rank";
+    return;
+  }
+  if (n_ == 1) {  // Nothing to estimate: the pose is the gauge.
+    s.status = SolverSummary::Status::kCertifiedOptimum;
+    s.final_rank = d_;
+    s.total_time_s = Elapsed();
+    ok_ = trivial_ = true;
+    return;
+  }
+
+  const auto t = Clock::now();
+  problem_ = std::make_unique<SESyncProblem>(
+      graph, ResolveNumThreads(options.num_threads));
+  if (!problem_->ok()) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message = "the translational Laplacian is not positive definite";
+    return;
+  }
+  certificate_ =
+      std::make_unique<CertificateMatrix>(*problem_, options.strict_round_off);
+  preconditioner_ = std::make_unique<SESyncPreconditioner>(
+      *problem_, ToInternal(options.preconditioner),
+      options.regularized_cholesky_max_condition, certificate_.get());
+  cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
+  scale_ = MaxDiagonal(problem_->D());
+  // Objective values below this are zero up to round-off (F is a sum of
+  // squares weighted by kappa and tau).
+  double total_weight = 0;
+  for (const RelativePoseMeasurement& e : graph.measurements) {
+    total_weight += e.kappa + e.tau;
+  }
+  zero_objective_ = 1e-12 * total_weight;
+  s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
+  ok_ = true;
+}
+
+Staircase::~Staircase() = default;
+
+double Staircase::Elapsed() const {
+  return std::chrono::duration<double>(Clock::now() - start_).count();
+}
+
+double Staircase::RemainingTime() const {
+  return options_.max_time_s > 0
+             ? std::max(1e-3, options_.max_time_s - Elapsed())
+             : 0;
+}
+
+Poses Staircase::Trivial() const {
+  return ToPosesInGauge(graph_, Eigen::MatrixXd::Identity(d_, d_),
+                        Eigen::MatrixXd::Zero(d_, 1));
+}
+
+bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
+  SolverSummary& s = *summary_;
+  const auto t = Clock::now();
+  const int d = d_, n = n_;
+  Y->setZero(r0_, d * n);
+  if (initial) {
+    for (int i = 0; i < n; ++i) {
+      Y->block(0, d * i, d, d) = ProjectToRotation((*initial)[i].R);
+    }
+  } else if (options_.initialization ==
+             SolverOptions::Initialization::kVertices) {
+    if (graph_.initial_poses.empty()) {
+      s.status = SolverSummary::Status::kInvalidInput;
+      s.message =
+          "initialization from vertices requested, but the graph has "
+          "no initial poses";
+      return false;
+    }
+    for (int i = 0; i < n; ++i) {
+      Y->block(0, d * i, d, d) = graph_.initial_poses[i].R;
+    }
+  } else if (options_.initialization ==
+             SolverOptions::Initialization::kRandom) {
+    std::mt19937_64 rng(options_.seed);
+    *Y = RandomStiefelProductPoint(d, r0_, n, &rng);
+  } else {
+    Eigen::MatrixXd R;
+    if (!ChordalRotationsFromLaplacian(problem_->RotationLaplacian(), d, &R)) {
+      s.status = SolverSummary::Status::kInvalidInput;
+      s.message = "chordal initialization failed";
+      return false;
+    }
+    Y->topRows(d) = R;
+  }
+  s.initialization_time_s =
+      std::chrono::duration<double>(Clock::now() - t).count();
+  return true;
+}
+
+void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
+                         SolverSummary::Level* level) {
+  SESyncCost& cost = *cost_;
+  // The gradient tolerance is relative to the final F, so repeat (cheaply,
+  // from the current point) if F dropped below the guess.
+  double f = cost.Evaluate(*Y);
+  const bool use_ceres =
+      options_.local_solver == SolverOptions::LocalSolver::kCeresLbfgs;
+  if (use_ceres) {
+    CeresLocalSolverSummary ceres_summary;
+    MinimizeWithCeresLbfgs(*problem_, options_.ceres_lbfgs_max_iterations,
+                           options_.ceres_lbfgs_gradient_tolerance,
+                           options_.relative_decrease_tolerance,
+                           RemainingTime(), Y, &ceres_summary);
+    level->iterations += ceres_summary.iterations;
+    level->termination = ceres_summary.termination;
+  }
+  RiemannianTrustRegionOptions rtr = TrustRegionOptions(options_);
+  rtr.callback = [&](int it, double f, double g, double radius, int inner) {
+    if (options_.verbose) {
+      LOG(INFO) << "rank " << rank << " iter " << it << " F " << f << " |grad| "
+                << g << " radius " << radius << " tCG " << inner;
+    }
+    return !options_.callback || options_.callback(rank, it, f, g, radius);
+  };
+  for (int pass = 0; pass < 3 && !use_ceres; ++pass) {
+    const double floor = 1e-14 * scale_;
+    rtr.preconditioned_gradient_tolerance =
+        options_.relative_preconditioned_gradient_tolerance *
+        std::sqrt(std::max(f, floor));
+    rtr.max_time_s = RemainingTime();
+    RiemannianTrustRegionSummary rtr_summary;
+    MinimizeRiemannianTrustRegion(rtr, &cost, Y, &rtr_summary);
+    level->iterations += rtr_summary.iterations;
+    level->hessian_vector_products += rtr_summary.hessian_vector_products;
+    level->gradient_norm = rtr_summary.final_gradient_norm;
+    level->termination = rtr_summary.TerminationString();
+    const double previous = f;
+    f = rtr_summary.final_cost;
+    if (rtr_summary.termination != RiemannianTrustRegionSummary::Termination::
+                                       kPreconditionedGradientTolerance ||
+        f >= 0.5 * previous) {
+      break;
+    }
+  }
+  cost.Evaluate(*Y);  // Make Y current (Lambda at Y).
+  if (use_ceres) {
+    Eigen::MatrixXd gradient;
+    cost.Gradient(&gradient);
+    level->gradient_norm = gradient.norm();
+  }
+}
+
+VerificationResult Staircase::Verify(double sdp_value) {
+  const int d = d_, n = n_;
+  const double eta_floor = options_.min_relative_eta * scale_;
+  const double eta_target =
+      std::max(eta_floor, options_.certification_target_relative_bound *
+                              sdp_value / (d * n));
+  const double eta_max =
+      std::max(eta_floor,
+               options_.certification_max_relative_bound * sdp_value / (d * n));
+  VerificationResult verification = VerifyCertificate(
+      *problem_, cost_->Lambda(), eta_target, eta_max, certificate_.get());
+  if (!verification.certified && sdp_value <= zero_objective_) {
+    // F >= 0 always: a (numerically) zero value is optimal as it stands.
+    verification.certified = true;
+    verification.eta = 0;
+  }
+  return verification;
+}
+
+bool Staircase::Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus) {
+  // Along [0; v^T] at rank r + 1, backtracking.
+  const int d = d_, n = n_, r = static_cast<int>(Y.rows());
+  Eigen::MatrixXd Y_up = Eigen::MatrixXd::Zero(r + 1, d * n);
+  Y_up.topRows(r) = Y;
+  Eigen::MatrixXd V = Eigen::MatrixXd::Zero(r + 1, d * n);
+  V.row(r) = verification_.direction.transpose();
+  double max_block_norm = 0;
+  for (int i = 0; i < n; ++i) {
+    max_block_norm = std::max(max_block_norm,
+                              verification_.direction.segment(d * i, d).norm());
+  }
+  double alpha = 1.0 / max_block_norm;
+  for (int k = 0; k < 60; ++k, alpha *= 0.5) {
+    RetractStiefelProduct(Y_up, alpha * V, d, Y_plus);
+    if (cost_->Evaluate(*Y_plus) < sdp_value_) return true;
+  }
+  return false;
+}
+
+void Staircase::Run(Eigen::MatrixXd* Y) {
+  SolverSummary& s = *summary_;
+  for (int r = static_cast<int>(Y->rows());; ++r) {
+    SolverSummary::Level level;
+    level.rank = r;
+    auto t = Clock::now();
+    Optimize(r, Y, &level);
+    level.optimize_time_s =
+        std::chrono::duration<double>(Clock::now() - t).count();
+    // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
+    sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
+    level.sdp_value = sdp_value_;
+
+    t = Clock::now();
+    verification_ = Verify(sdp_value_);
+    level.verify_time_s =
+        std::chrono::duration<double>(Clock::now() - t).count();
+    level.certified = verification_.certified;
+    level.eta = verification_.eta;
+    level.lambda_min_estimate = verification_.lambda_min_estimate;
+    s.factorizations += verification_.factorizations;
+    s.iterations += level.iterations;
+    s.hessian_vector_products += level.hessian_vector_products;
+    s.optimization_time_s += level.optimize_time_s;
+    s.verification_time_s += level.verify_time_s;
+    s.levels.push_back(level);
+    s.final_rank = r;
+    if (options_.verbose) {
+      LOG(INFO) << "rank " << r << ": F(Y) " << sdp_value_ << ", eta "
+                << verification_.eta << ", lambda_min estimate "
+                << verification_.lambda_min_estimate
+                << (verification_.certified ? " (certified)" : "");
+    }
+    if (verification_.certified) {
+      s.status = SolverSummary::Status::kCertifiedOptimum;
+      return;
+    }
+    if (verification_.eigensolver_failed) {
+      s.status = SolverSummary::Status::kEigenImprecision;
+      return;
+    }
+    if (options_.max_time_s > 0 && Elapsed() >= options_.max_time_s) {
+      s.status = SolverSummary::Status::kTimeLimit;
+      return;
+    }
+    if (r >= options_.max_rank) {
+      s.status = SolverSummary::Status::kMaxRankReached;
+      return;
+    }
+    Eigen::MatrixXd Y_plus;
+    if (!Escape(*Y, &Y_plus)) {
+      s.status = SolverSummary::Status::kSaddleNotEscaped;
+      cost_->Evaluate(*Y);
+      return;
+    }
+    *Y = std::move(Y_plus);
+  }
+}
+
+Poses Staircase::Round(const Eigen::MatrixXd& Y) {
+  SolverSummary& s = *summary_;
+  const auto t = Clock::now();
+  Eigen::MatrixXd R = RoundSolution(Y, d_);
+  if (options_.refine_rounded_solution) {
+    // Local search on O(d)^n = St(d, d)^n from the rounded rotations (blocks
+    // stay in SO(d) by continuity). A no-op when the relaxation is exact.
+    const double rounded = cost_->Evaluate(R);
+    if (rounded > sdp_value_ * (1 + 1e-12)) {
+      RiemannianTrustRegionOptions rtr = TrustRegionOptions(options_);
+      rtr.max_time_s = RemainingTime();
+      rtr.preconditioned_gradient_tolerance =
+          options_.relative_preconditioned_gradient_tolerance *
+          std::sqrt(rounded);
+      RiemannianTrustRegionSummary refine_summary;
+      MinimizeRiemannianTrustRegion(rtr, cost_.get(), &R, &refine_summary);
+      s.iterations += refine_summary.iterations;
+      s.hessian_vector_products += refine_summary.hessian_vector_products;
+      R = ProjectBlocksToRotations(R, d_);
+    }
+  }
+  const Eigen::MatrixXd T = problem_->RecoverTranslations(R);
+  Poses poses = ToPosesInGauge(graph_, R, T);
+  s.rounding_time_s = std::chrono::duration<double>(Clock::now() - t).count();
+  return poses;
+}
+
+void Staircase::Report(const Poses& poses) {
+  SolverSummary& s = *summary_;
+  const int d = d_, n = n_;
+  s.sdp_value = sdp_value_;
+  s.objective = EvaluateObjective(graph_, poses);
+  s.eta = verification_.eta;
+  s.lambda_min_estimate = verification_.lambda_min_estimate;
+  s.rounding_gap = (s.objective - sdp_value_) / std::max(sdp_value_, 1e-300);
+  // tr(Lambda) - eta d n bounds the optimum whenever S + eta I was proven
+  // PSD, certified or not.
+  s.lower_bound = std::isfinite(s.eta)
+                      ? std::max(0.0, sdp_value_ - s.eta * d * n)
+                      : 0.0;  // F >= 0 always.
+  // The attained objective bounds the optimum too (guards F(Y) round-off).
+  s.lower_bound = std::min(s.lower_bound, s.objective);
+  s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
+  s.relative_suboptimality_bound =
+      s.lower_bound > 0 ? s.suboptimality_bound / s.lower_bound
+      : s.objective <= zero_objective_
+          ? 0
+          : std::numeric_limits<double>::infinity();
+  if (s.status == SolverSummary::Status::kCertifiedOptimum &&
+      !(s.relative_suboptimality_bound <=
+            options_.certification_max_relative_bound &&
+        (s.rounding_gap <= options_.certification_max_rounding_gap ||
+         s.objective <= zero_objective_))) {
+    // Y is optimal for the SDP, but the rounded poses are not provably
+    // optimal: the relaxation is not exact on this problem.
+    s.status = SolverSummary::Status::kRelaxationNotExact;
+  }
+  s.total_time_s = Elapsed();
+}
+
+}  // namespace ceres_sesync::internal

@@ -1,0 +1,124 @@
+// The stages of Solve(), callable on their own:
+//
+//   problem -> initialize -> staircase -> (verify per level) -> round -> report
+//
+// so that outer loops (a robust GNC solve re-weighting the same graph), other
+// problem contents (landmarks, priors) and the bindings reuse one staircase
+// instead of copies of it. Solve() is exactly
+//
+//   Staircase staircase(graph, options, summary);   // problem (validates)
+//   if (!staircase.ok()) return {};
+//   Eigen::MatrixXd Y;
+//   if (!staircase.Initialize(initial, &Y)) return {};
+//   staircase.Run(&Y);                               // optimize / verify /
+//                                                    // escape, level by level
+//   Poses poses = staircase.Round(Y);                // Algorithm 2 + eq. (21)
+//   staircase.Report(poses);                         // objective, bounds,
+//   status
+//
+// Every stage records what it did in the SolverSummary given at
+// construction (times, levels, counts).
+
+#ifndef CERES_SESYNC_INTERNAL_STAIRCASE_H_
+#define CERES_SESYNC_INTERNAL_STAIRCASE_H_
+
+#include <chrono>
+#include <memory>
+
+#include "Eigen/Core"
+#include "ceres_sesync/internal/certificate_matrix.h"
+#include "ceres_sesync/internal/sesync_cost.h"
+#include "ceres_sesync/internal/sesync_problem.h"
+#include "ceres_sesync/internal/verification.h"
+#include "ceres_sesync/pose_graph.h"
+#include "ceres_sesync/sesync_solver.h"
+
+namespace ceres_sesync::internal {
+
+class Staircase {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  // Stage "problem": validates `graph` and `options` and builds the data
+  // matrices, the certificate matrix's symbolic analysis and the
+  // preconditioner. `graph`, `options` and `summary` must outlive this
+  // object; `summary` is reset. Time limits count from `start`.
+  Staircase(const PoseGraph& graph, const SolverOptions& options,
+            SolverSummary* summary, Clock::time_point start = Clock::now());
+  ~Staircase();
+
+  // False if validation or the data matrices failed (summary has the status
+  // and message), or the problem is trivial (n = 1: Trivial() holds the
+  // answer).
+  bool ok() const { return ok_; }
+  // n == 1 with a valid graph: the single pose is the gauge; the summary is
+  // complete and Trivial() returns the poses.
+  bool trivial() const { return trivial_; }
+  Poses Trivial() const;
+
+  // Stage "initialize": Y (r0 x dn) from `initial` (its rotations projected
+  // to SO(d)) or, if null, from options.initialization. False (summary has
+  // the status) if the requested initialization is unavailable.
+  bool Initialize(const Poses* initial, Eigen::MatrixXd* Y);
+
+  // Stage "staircase": from Y (any rank >= d + 1), optimize, verify, and
+  // escape saddles rank by rank until certified or stopped (the summary's
+  // status). On return Y is the final factor and the cost is evaluated there.
+  void Run(Eigen::MatrixXd* Y);
+
+  // Stage "verify", for the current point of the cost (Lambda at Y) with
+  // F(Y) = sdp_value: proves S + eta I positive semidefinite for the smallest
+  // eta it can, within the options' certification targets.
+  VerificationResult Verify(double sdp_value);
+
+  // Stage "round": Algorithm 2 on Y, the optional refinement on SO(d)^n, the
+  // optimal translations (eq. 21), in the documented gauge.
+  Poses Round(const Eigen::MatrixXd& Y);
+
+  // Stage "report": objective, lower bound, suboptimality bounds, rounding
+  // gap, final status and total time for the returned `poses`.
+  void Report(const Poses& poses);
+
+  const SESyncProblem& problem() const { return *problem_; }
+  SESyncCost& cost() { return *cost_; }
+  // The last level's verification (after Run()).
+  const VerificationResult& verification() const { return verification_; }
+  // F(Y) at the end of Run().
+  double sdp_value() const { return sdp_value_; }
+
+ private:
+  double Elapsed() const;
+  // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
+  double RemainingTime() const;
+  // One level's local optimization (RTR or Ceres LBFGS) from Y.
+  void Optimize(int rank, Eigen::MatrixXd* Y, SolverSummary::Level* level);
+  // Escapes the saddle at rank r along the verification's direction; false
+  // if no descent was found.
+  bool Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus);
+
+  const PoseGraph& graph_;
+  const SolverOptions& options_;
+  SolverSummary* summary_;
+  Clock::time_point start_;
+  bool ok_ = false;
+  bool trivial_ = false;
+  int d_ = 0, n_ = 0, r0_ = 0;
+  double scale_ = 0;           // max diag(D)
+  double zero_objective_ = 0;  // F below this is zero up to round-off.
+  std::unique_ptr<SESyncProblem> problem_;
+  std::unique_ptr<CertificateMatrix> certificate_;
+  std::unique_ptr<SESyncPreconditioner> preconditioner_;
+  std::unique_ptr<SESyncCost> cost_;
+  VerificationResult verification_;
+  double sdp_value_ = 0;
+};
+
+// Poses from rotations R (d x dn) and translations T (d x n), expressed in the
+// documented gauge: the FIX pose (else pose 0) sits at its initial value (else
+// at the identity).
+Poses ToPosesInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
+                     const Eigen::MatrixXd& T);
+
+}  // namespace ceres_sesync::internal
+
+#endif  // CERES_SESYNC_INTERNAL_STAIRCASE_H_
