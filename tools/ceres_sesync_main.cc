@@ -11,10 +11,10 @@
 DEFINE_string(json, "", "Write a machine-readable JSON summary to this path.");
 DEFINE_string(output, "", "Write the resulting poses (g2o) to this path.");
 DEFINE_bool(verbose, false, "Log solver progress to stderr.");
-DEFINE_bool(strict_round_off, false,
-            "solve/certify: account rigorously for the round-off of the "
-            "certificate's translation block (SolverOptions::"
-            "strict_round_off).");
+DEFINE_string(proof_arithmetic, "automatic",
+              "solve, certify: arithmetic of the certificate's proof: "
+              "'automatic' (double, then double-double when double cannot "
+              "reach the goal bound), 'double' or 'double-double'.");
 DEFINE_int32(num_threads, 0,
              "solve, certify: threads for the O(m r) kernels (0: all cores).");
 
