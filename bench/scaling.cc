@@ -6,7 +6,8 @@
 //           [--city3d_sizes LIST] [--cube_sides LIST] [--cube_kappa K]
 //           [--cube_tau T] [--methods sesync,pdl,lm] [--ceres_max_time S]
 //           [--sesync_max_time S] [--max_time S] [--child_timeout S]
-//           [--repeats N] [--num_threads N] [--seed N] [--out_dir DIR]
+//           [--max_memory_gb G] [--repeats N] [--num_threads N] [--seed N]
+//           [--out_dir DIR]
 //
 // Every run (graph, method, repeat) is a child process (fork) that generates
 // the graph itself (deterministic for the seed; not timed as part of the
@@ -19,7 +20,8 @@
 //    initialization, as in bench.cc.
 // One process per run gives each its own peak RSS (VmHWM at the end of the
 // child, which includes the graph; "graph" = VmHWM right after generating
-// it), and a crash or --child_timeout kill loses only that run.
+// it), and a crash, a --child_timeout kill or an allocation failure at the
+// --max_memory_gb address-space limit loses only that run.
 //
 // Ceres results are compared with SE-Sync's proven lower bound LB on the same
 // graph: gap = (F - LB) / LB. Time ratios are method / SE-Sync. Log-log
@@ -33,6 +35,7 @@
 // bench/plot_scaling.py draws scaling.png from scaling.csv.
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -67,8 +70,9 @@ DEFINE_string(families, "city2d,city3d,cube",
               "Comma-separated graph families: city2d, city3d, cube.");
 DEFINE_string(city2d_sizes, "1000,3000,10000,30000,100000,300000,1000000",
               "Numbers of poses of the 2D city runs.");
-DEFINE_string(city3d_sizes, "1000,3000,10000,30000,100000,300000,1000000",
-              "Numbers of poses of the 3D city runs.");
+DEFINE_string(city3d_sizes, "1000,3000,10000,30000,100000",
+              "Numbers of poses of the 3D city runs (the fill of the 3D "
+              "factorizations grows fast: 10^5 already takes minutes).");
 DEFINE_string(cube_sides, "10,15,22,30,46",
               "Sides s of the 3D cube runs (n = s^3; 46 is the issue's "
               "97,336-pose cube).");
@@ -88,6 +92,10 @@ DEFINE_double(max_time, 1800,
               "runs took longer than this many seconds.");
 DEFINE_double(child_timeout, 7200,
               "Kill a run (child process) after this many seconds.");
+DEFINE_double(max_memory_gb, 20,
+              "Address-space limit (RLIMIT_AS) of each run's process, in GiB "
+              "(0: none): a run that needs more fails (reported) instead of "
+              "driving a shared machine into the OOM killer.");
 DEFINE_int32(repeats, 1,
              "Runs per graph and method (the fastest is reported).");
 DEFINE_int32(num_threads, 1,
@@ -249,6 +257,12 @@ bool RunInChild(const std::string& family, int size, const std::string& method,
   if (pid == 0) {
     close(fds[0]);
     alarm(static_cast<unsigned>(std::max(1.0, FLAGS_child_timeout)));
+    if (FLAGS_max_memory_gb > 0) {
+      const rlim_t bytes =
+          static_cast<rlim_t>(FLAGS_max_memory_gb * 1024 * 1024 * 1024);
+      const struct rlimit limit = {bytes, bytes};
+      setrlimit(RLIMIT_AS, &limit);
+    }
     const RunResult r = RunMethod(family, size, method);
     const char* p = reinterpret_cast<const char*>(&r);
     size_t left = sizeof(r);
@@ -421,6 +435,8 @@ int main(int argc, char** argv) {
           SetStatus(&row.result,
                     "skipped (slower than --max_time at a "
                     "smaller size, or failed)");
+          std::fprintf(stderr, "%-6s size %-8d %-7s %s\n", family.c_str(), size,
+                       MethodName(method), row.result.status);
           rows.push_back(row);
           continue;
         }
@@ -473,8 +489,10 @@ int main(int argc, char** argv) {
      << " hardware threads; load average (1 / 5 / 15 min) at start "
      << load_at_start << ", at end " << LoadAverage()
      << " (timings taken under load are not comparable); Ceres limit "
-     << FLAGS_ceres_max_time << " s; fastest of " << repeats
-     << " run(s); wall time of the whole bench "
+     << FLAGS_ceres_max_time << " s; address-space limit per run "
+     << (FLAGS_max_memory_gb > 0 ? Fmt("%g GiB", FLAGS_max_memory_gb)
+                                 : std::string("none"))
+     << "; fastest of " << repeats << " run(s); wall time of the whole bench "
      << Fmt("%.0f", SecondsSince(start))
      << " s. SE-Sync [s] is the wall time of Solve() (stages: data matrices, "
         "chordal initialization, staircase optimization, verification, "
@@ -501,9 +519,11 @@ int main(int argc, char** argv) {
         }
       }
       const Row* s = by_method[0];
-      const Row* any = s && s->ok                         ? s
-                       : by_method[1] && by_method[1]->ok ? by_method[1]
-                                                          : by_method[2];
+      const Row* any = nullptr;  // The row that names the graph.
+      for (const Row* row : by_method) {
+        if (row && (row->ok || !any)) any = row;
+        if (any && any->ok) break;
+      }
       if (!any) continue;
       const RunResult& g = any->result;
       md << "| " << (g.n ? std::to_string(g.n) : "size " + std::to_string(size))
@@ -533,7 +553,7 @@ int main(int argc, char** argv) {
         if (c && c->ok) {
           md << Fmt("%.3f", c->result.time_s) << " | " << Fmt("%.2f", c->ratio)
              << " | " << Fmt("%.1e", c->gap) << " | " << c->result.status
-             << " | ";
+             << ", " << c->result.iterations << " it | ";
         } else {
           md << " | | | " << (c ? c->result.status : "") << " | ";
         }
