@@ -47,6 +47,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "ceres_sesync/ceres_baseline.h"
 #include "ceres_sesync/certification.h"
 #include "ceres_sesync/chordal_initialization.h"
@@ -100,33 +101,20 @@ DEFINE_int32(lbfgs_repeats, 1,
 namespace ceres_sesync {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using bench::CeresStatus;
+using bench::Clock;
+using bench::CsvField;
+using bench::Fmt;
+using bench::Median;
+using bench::Min;
+using bench::PeakRssMiB;
+using bench::SecondsSince;
+using bench::Sum;
 
 // Whether to run repeat number `done` (0-based) given the time `spent` so
 // far: at least `repeats` runs, more until --min_time (100 runs at most).
 bool Again(int done, int repeats, double spent, bool extend = true) {
   return done < repeats || (extend && spent < FLAGS_min_time && done < 100);
-}
-
-double Sum(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return s;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t k = v.size() / 2;
-  return v.size() % 2 ? v[k] : 0.5 * (v[k - 1] + v[k]);
-}
-
-double Min(const std::vector<double>& v) {
-  return v.empty() ? NAN : *std::min_element(v.begin(), v.end());
 }
 
 // Optimal values of Tables 1-2 of the paper, as cited in
@@ -166,13 +154,6 @@ struct Stages {
   double wall_s = 0;
 };
 
-std::string Fmt(const char* format, double v) {
-  if (std::isnan(v)) return "";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, v);
-  return buf;
-}
-
 std::string BaseName(const std::string& path) {
   return std::filesystem::path(path).stem().string();
 }
@@ -205,19 +186,6 @@ void CertifyInto(const PoseGraph& graph, const Poses& poses, Row* row,
                  << ": Certify says certified but its relative bound is "
                  << certificate.relative_suboptimality_bound;
   }
-}
-
-std::string CeresStatus(const CeresBaselineSummary& s) {
-  const ceres::Solver::Summary& c = s.solver_summary;
-  if (c.termination_type == ceres::CONVERGENCE) return "converged";
-  if (c.termination_type == ceres::NO_CONVERGENCE) {
-    if (c.message.find("time") != std::string::npos) return "timeout";
-    if (c.message.find("iteration") != std::string::npos) {
-      return "max_iterations";
-    }
-    return "no_convergence";
-  }
-  return ceres::TerminationTypeToString(c.termination_type);
 }
 
 // Runs Ceres `repeats` times from `initial` (whose computation took
@@ -259,21 +227,6 @@ Row RunCeres(const PoseGraph& graph, const std::string& dataset,
                row.method.c_str(), init.c_str(), Min(row.times), row.objective,
                row.status.c_str(), row.certified.c_str());
   return row;
-}
-
-// Peak resident set size of this process so far (VmHWM), in MiB.
-double PeakRssMiB() {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) {
-      std::istringstream s(line.substr(6));
-      double kb = 0;
-      s >> kb;
-      return kb / 1024.0;
-    }
-  }
-  return NAN;
 }
 
 // A short form of a level's termination message ("ceres LBFGS: Function
@@ -492,13 +445,6 @@ bool BenchDataset(const std::string& path, int repeats,
   std::fprintf(stderr, "  peak RSS of the process so far: %.0f MiB\n",
                PeakRssMiB());
   return true;
-}
-
-std::string CsvField(const std::string& s) {
-  if (s.find_first_of(",\"") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += (c == '"') ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
 }
 
 }  // namespace
