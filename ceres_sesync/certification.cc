@@ -89,6 +89,16 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
         verification.policy = internal::ProofPolicy::kDoubleDouble;
         break;
     }
+    // The candidate's spread from pose 0 (see VerificationOptions).
+    for (int a = 0; a < d; ++a) {
+      double sum = 0;
+      for (int i = 0; i < n; ++i) {
+        const double x = projected[i].t(a) - projected[0].t(a);
+        sum += x * x;
+      }
+      verification.translation_spread =
+          std::max(verification.translation_spread, sum / n);
+    }
     internal::CertificateMatrix matrix(problem);
     const internal::VerificationResult v =
         internal::VerifyCertificate(problem, Lambda, verification, &matrix);

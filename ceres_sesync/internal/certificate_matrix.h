@@ -79,6 +79,8 @@ class CertificateMatrix {
   double backward_error() const { return backward_error_; }
   // mu of the current double factor (0 after Factorize()).
   double translation_shift() const { return factorized_shift_; }
+  // The mu the next double proof starts with (adapted from the last one).
+  double next_double_shift() const { return double_shift_; }
 
   // Factorizations so far, by arithmetic, and the seconds spent in the
   // double-double ones (including their assembly and symbolic analysis).

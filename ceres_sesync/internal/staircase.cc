@@ -234,6 +234,12 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
 
 namespace {
 
+// max_a sum_i (t_i(a) - t_0(a))^2 / n for translations T (d x n).
+double TranslationSpread(const Eigen::MatrixXd& T) {
+  const Eigen::MatrixXd centered = T.colwise() - T.col(0);
+  return centered.rowwise().squaredNorm().maxCoeff() / T.cols();
+}
+
 ProofPolicy ToPolicy(SolverOptions::ProofArithmetic arithmetic) {
   switch (arithmetic) {
     case SolverOptions::ProofArithmetic::kAutomatic:
@@ -270,9 +276,9 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
   // would mostly be wasted: it is deferred to Report(), which runs it only
   // if the tolerance needs it.
   extended_deferred_ = false;
+  const Eigen::MatrixXd R = RoundSolution(Y, d);
   if (verification_options.policy == ProofPolicy::kAutomatic && Y.rows() > d &&
       sdp_value > 0) {
-    const Eigen::MatrixXd R = RoundSolution(Y, d);
     Eigen::MatrixXd RQ;
     problem_->MultiplyQ(R, &RQ);
     const double gap = (R.cwiseProduct(RQ).sum() - sdp_value) / sdp_value;
@@ -281,6 +287,8 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
       extended_deferred_ = true;
     }
   }
+  verification_options.translation_spread =
+      TranslationSpread(problem_->RecoverTranslations(R));
   VerificationResult verification = VerifyCertificate(
       *problem_, cost_->Lambda(), verification_options, certificate_.get());
   if (!verification.certified && sdp_value <= zero_objective_) {

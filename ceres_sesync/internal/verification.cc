@@ -170,11 +170,22 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
 
   // 1. The fast path: a proof at the target shift, then in double one at a
   // quarter of the goal (where double suffices, e.g. compact 3D maps, that
-  // is all it takes).
-  if (prove(eta_target, first) && result.eta <= goal) return finish();
-  if (first == ProofPrecision::kDouble && goal / 4 > eta_target &&
-      prove(goal / 4, ProofPrecision::kDouble) && result.eta <= goal) {
-    return finish();
+  // is all it takes). Double proofs below the cost of their translation
+  // shift (options.translation_spread) would fail: start above it, and skip
+  // double altogether when that cost is above the goal.
+  const double double_floor =
+      matrix->next_double_shift() * options.translation_spread;
+  VLOG(1) << "verification: double floor " << double_floor << " (target "
+          << eta_target << ", goal " << goal << ", max " << eta_max << ")";
+  if (first == ProofPrecision::kDoubleDouble) {
+    if (prove(eta_target, first) && result.eta <= goal) return finish();
+  } else if (double_floor <= goal / 4 || !use_extended) {
+    const double c1 = std::max(eta_target, 1.5 * double_floor);
+    if (prove(c1, first) && result.eta <= goal) return finish();
+    if (goal / 4 > c1 && prove(goal / 4, ProofPrecision::kDouble) &&
+        result.eta <= goal) {
+      return finish();
+    }
   }
 
   // 2. Near-optimal (lambda_min(S) > -eta_max up to round-off) or not?

@@ -26,6 +26,12 @@ struct VerificationOptions {
   // <= 0: the goal is out of reach, use eta_max.
   double eta_goal = 0;
   ProofPolicy policy = ProofPolicy::kAutomatic;
+  // max over coordinates a of sum_i (t_i(a) - t_0(a))^2 / n for the
+  // candidate's translations (0: unknown). A double proof lowers the
+  // translation block by mu, which costs about mu times this in
+  // lambda_min(S) (the global-rotation directions, where S is near
+  // singular): shifts below that are not tried in double.
+  double translation_spread = 0;
 };
 
 struct VerificationResult {
