@@ -363,15 +363,16 @@ TEST_F(InfoCommandTest, BadFileExitsWithTwoNamingTheLineAndWritesNoJson) {
 }
 
 TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
-  const std::string graph = TempPath("landmarks.g2o");
-  const std::string json_path = TempPath("landmarks.json");
+  const std::string graph = TempPath("bearing.g2o");
+  const std::string json_path = TempPath("bearing.json");
   WriteText(graph,
             "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
-            "VERTEX_XY 5 1 2\n");
+            "EDGE_BEARING_SE2_XY 0 5 0.5 1\n");
   RunResult run = RunTool("info " + graph);
   EXPECT_EQ(run.exit_code, 2) << run.output;
-  EXPECT_NE(run.output.find(graph + ":2: unsupported tag 'VERTEX_XY'"),
-            std::string::npos)
+  EXPECT_NE(
+      run.output.find(graph + ":2: unsupported tag 'EDGE_BEARING_SE2_XY'"),
+      std::string::npos)
       << run.output;
 
   run =
@@ -381,7 +382,7 @@ TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
   const std::string json = ReadText(json_path);
   EXPECT_TRUE(IsValidJson(json)) << json;
   EXPECT_NE(json.find("\"num_skipped_lines\": 1"), std::string::npos) << json;
-  EXPECT_NE(json.find("\"VERTEX_XY\": 1"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"EDGE_BEARING_SE2_XY\": 1"), std::string::npos) << json;
   fs::remove(graph);
   fs::remove(json_path);
 }
