@@ -387,6 +387,39 @@ TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
   fs::remove(json_path);
 }
 
+TEST_F(InfoCommandTest, CountsLandmarksAndPriors) {
+  const std::string graph = TempPath("landmarks.g2o");
+  const std::string json_path = TempPath("landmarks.json");
+  // Two landmarks (4 I and 2 I: nu 4 and 2), three measurements, one prior
+  // of each kind.
+  WriteText(graph,
+            "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
+            "EDGE_SE2_XY 0 10 1 2 4 0 4\n"
+            "EDGE_SE2_XY 1 10 0 2 4 0 4\n"
+            "EDGE_SE2_XY 1 11 0 2 2 0 2\n"
+            "EDGE_PRIOR_SE2_XY 0 0 0 9 0 9\n"
+            "EDGE_PRIOR_SE2 1 1 0 0 0 0 0 0 0 3\n"
+            "EDGE_PRIOR_SE2 0 0 0 0 1 0 0 1 0 3\n");
+  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "landmarks:"), "2") << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "landmark measurements:"), "3");
+  EXPECT_EQ(ValueAfter(run.output, "nu min / median / max:"), "2 / 4 / 4");
+  EXPECT_EQ(ValueAfter(run.output, "priors:"),
+            "3 (position 1, rotation 1, pose 1)");
+  const std::string json = ReadText(json_path);
+  EXPECT_TRUE(IsValidJson(json)) << json;
+  for (const char* field :
+       {"\"num_landmarks\": 2", "\"num_landmark_measurements\": 3",
+        "\"num_priors\": 3", "\"position\": 1", "\"rotation\": 1",
+        "\"pose\": 1", "\"has_initial_landmarks\": false"}) {
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+  }
+  EXPECT_NEAR(JsonNumber(json, "\"nu\"", "min"), 2, 1e-14);
+  fs::remove(graph);
+  fs::remove(json_path);
+}
+
 TEST_F(InfoCommandTest, UsageErrorsExitWithTwo) {
   EXPECT_EQ(RunTool("info").exit_code, 2);
   const std::string missing = TempPath("missing.g2o");
