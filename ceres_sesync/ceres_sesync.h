@@ -5,9 +5,10 @@
 // The public API (each header documents its part):
 //
 //   pose_graph.h              The data model: PoseGraph,
-//   RelativePoseMeasurement,
-//                             Pose/Poses, EvaluateObjective (eq. 12),
-//                             ValidatePoseGraph.
+//                             RelativePoseMeasurement, LandmarkMeasurement,
+//                             PosePrior, Pose/Poses, Solution,
+//                             EvaluateObjective (eq. 12 + landmark and prior
+//                             terms), ValidatePoseGraph.
 //   g2o_io.h                  Reading/writing g2o files, writing TUM
 //                             trajectories.
 //   sesync_solver.h           Solve(): SE-Sync, certifiably correct pose-graph
@@ -23,6 +24,8 @@
 //                             odometry initialization.
 //   chordal_initialization.h  The chordal rotation initialization.
 //   cube_generator.h          The synthetic cube benchmark of the paper.
+//   landmark_generator.h      A synthetic landmark-SLAM benchmark (Manhattan
+//                             walk, random landmarks, GPS / start priors).
 //   langevin.h                The isotropic Langevin / von Mises noise
 //                             samplers used by the generator.
 //   stiefel_manifold.h        St(d, r) and St(d, r)^n: free functions and
@@ -41,6 +44,7 @@
 #include "ceres_sesync/chordal_initialization.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/langevin.h"
 #include "ceres_sesync/pose_conversions.h"
 #include "ceres_sesync/pose_graph.h"

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "Eigen/Geometry"
+#include "ceres_sesync/internal/heading_rotation.h"
 #include "ceres_sesync/langevin.h"
 
 namespace ceres_sesync {
@@ -38,25 +39,6 @@ std::vector<LatticePoint> RectilinearPath(int d, int s) {
     }
   }
   return path;
-}
-
-// A rotation whose first column (the body's forward axis) is `forward`, a
-// lattice axis direction.
-Eigen::MatrixXd HeadingRotation(int d, const Eigen::Vector3d& forward) {
-  if (d == 2) {
-    Eigen::MatrixXd R(2, 2);
-    R << forward.x(), -forward.y(), forward.y(), forward.x();
-    return R;
-  }
-  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d left = std::abs(forward.z()) > 0.5
-                                   ? Eigen::Vector3d::UnitY().eval()
-                                   : up.cross(forward).eval();
-  Eigen::MatrixXd R(3, 3);
-  R.col(0) = forward;
-  R.col(1) = left;
-  R.col(2) = forward.cross(left);
-  return R;
 }
 
 // The lattice offsets of the loop-closure candidates of a pose: every
@@ -149,7 +131,7 @@ bool GenerateCube(const CubeOptions& options, PoseGraph* graph,
     const int a = i + 1 < n ? i : i - 1;  // heading from a to a + 1
     Eigen::Vector3d forward;
     for (int k = 0; k < 3; ++k) forward[k] = path[a + 1][k] - path[a][k];
-    truth[i].R = HeadingRotation(d, forward);
+    truth[i].R = internal::HeadingRotation(d, forward);
     truth[i].t.resize(d);
     for (int k = 0; k < d; ++k) truth[i].t[k] = options.spacing * path[i][k];
   }

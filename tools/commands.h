@@ -30,6 +30,9 @@ int RunInfo(const Args& args);
 int RunSolve(const Args& args);
 int RunCertify(const Args& args);
 int RunGenerate(const Args& args);
+// `generate landmarks` (generate_landmarks_command.cc); `args` starts with
+// "landmarks".
+int RunGenerateLandmarks(const Args& args);
 
 }  // namespace ceres_sesync::tools
 

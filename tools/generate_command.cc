@@ -1,5 +1,6 @@
 // `ceres_sesync generate cube ...`: writes a synthetic cube (or 2D grid)
 // pose graph of SE-Sync's Section 6.1 (see ceres_sesync/cube_generator.h).
+// `generate landmarks ...` is in generate_landmarks_command.cc.
 
 #include <cstdio>
 #include <string>
@@ -65,9 +66,12 @@ Poses DeadReckoning(const PoseGraph& graph) {
 }  // namespace
 
 int RunGenerate(const Args& args) {
-  if (args.empty()) return UsageError("missing the model name (cube)");
+  if (args.empty()) {
+    return UsageError("missing the model name (cube or landmarks)");
+  }
+  if (args[0] == "landmarks") return RunGenerateLandmarks(args);
   if (args[0] != "cube") {
-    return UsageError("unknown model '" + args[0] + "' (only 'cube')");
+    return UsageError("unknown model '" + args[0] + "' (cube or landmarks)");
   }
   if (args.size() > 1) {
     return UsageError("unexpected argument '" + args[1] + "'");
