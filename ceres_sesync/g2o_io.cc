@@ -940,6 +940,24 @@ bool ParseG2oText(std::string_view text, const std::string& name,
     return at.Fail(s.str());
   }
 
+  if (!graph->priors.empty()) {
+    const int k = TranslationalComponents(*graph, &component);
+    if (k > 1) {
+      const int n = graph->num_poses;
+      int stray = 0;
+      while (component[stray] == component[0]) ++stray;
+      std::ostringstream s;
+      s << "the translational terms are disconnected: " << k << " components; "
+        << (stray < n ? "vertex " : "landmark ")
+        << (stray < n ? graph->vertex_ids[stray]
+                      : graph->landmark_ids[stray - n])
+        << " (first seen here) is tied to vertex " << graph->vertex_ids[0]
+        << " only through rotation priors, so its translation would be free";
+      at.line = stray < n ? first_line[stray] : landmark_first_line[stray - n];
+      return at.Fail(s.str());
+    }
+  }
+
   std::string invalid;
   ValidationOptions validation;
   validation.allow_landmarks_and_priors = true;

@@ -90,7 +90,9 @@
 // landmarks that no edge observes, undefined or duplicate parameter ids,
 // EDGE_SE3_PRIOR offsets with a translation, FIX together with priors (the
 // priors fix the gauge), files without edges, and disconnected graphs
-// (poses and landmarks; priors connect their poses through the world frame).
+// (poses and landmarks; priors connect their poses through the world frame;
+// the translational terms must be connected too, see
+// TranslationalComponents in pose_graph.h).
 // The result always passes ValidatePoseGraph() with
 // ValidationOptions::allow_landmarks_and_priors.
 //

@@ -55,7 +55,13 @@ bool IsRotation(const Eigen::MatrixXd& R, int d, double tolerance) {
 }
 }  // namespace
 
-int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
+namespace {
+
+// Components of poses and landmarks linked by the measurements, landmark
+// measurements and priors; with `translations_only`, priors link their pose
+// to the world node only if they have a position term.
+int Components(const PoseGraph& graph, bool translations_only,
+               std::vector<int>* component) {
   const int n = graph.num_poses;
   const int L = std::max(graph.num_landmarks, 0);
   // Nodes: poses 0..n-1, landmarks n..n+L-1, the world node n+L.
@@ -73,7 +79,7 @@ int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
     if (is_pose(o.i) && o.l >= 0 && o.l < L) unite(o.i, n + o.l);
   }
   for (const auto& p : graph.priors) {
-    if (is_pose(p.i)) unite(p.i, world);
+    if (is_pose(p.i) && (!translations_only || p.tau > 0)) unite(p.i, world);
   }
   std::vector<int> label(n + L, -1), root_label(world + 1, -1);
   int k = 0;
@@ -84,6 +90,17 @@ int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
   }
   if (component) *component = std::move(label);
   return k;
+}
+
+}  // namespace
+
+int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
+  return Components(graph, false, component);
+}
+
+int TranslationalComponents(const PoseGraph& graph,
+                            std::vector<int>* component) {
+  return Components(graph, true, component);
 }
 
 bool ValidatePoseGraph(const PoseGraph& graph, std::string* error) {
@@ -231,6 +248,16 @@ bool ValidatePoseGraph(const PoseGraph& graph, const ValidationOptions& options,
     std::ostringstream s;
     s << "measurement graph is disconnected: " << k << " components";
     return fail(s.str());
+  }
+  if (!graph.priors.empty()) {  // Else the same as ConnectedComponents.
+    const int kt = TranslationalComponents(graph, nullptr);
+    if (kt != 1) {
+      std::ostringstream s;
+      s << "the translational terms are disconnected: " << kt
+        << " components (a part tied to the rest only by rotation priors "
+           "would have a free translation)";
+      return fail(s.str());
+    }
   }
   if (!options.allow_landmarks_and_priors && graph.has_landmarks_or_priors()) {
     std::ostringstream s;

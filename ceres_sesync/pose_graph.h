@@ -151,6 +151,15 @@ struct PoseGraph {
 // one per landmark (num_poses + num_landmarks entries).
 int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component);
 
+// The same for the translational terms only: edges, landmark measurements
+// and the priors with a position term (tau > 0). Rotation-only priors tie a
+// pose to the world frame in rotation only, so a part of the graph linked to
+// the rest only by them has a translation of its own to fix (a gauge
+// freedom, like a disconnected pose graph); ValidatePoseGraph rejects that.
+// Without priors this equals ConnectedComponents.
+int TranslationalComponents(const PoseGraph& graph,
+                            std::vector<int>* component);
+
 struct ValidationOptions {
   // TEMPORARY (issue #15): the solver core (Solve, Certify, the chordal
   // initialization) does not handle landmarks and priors yet. The
@@ -170,7 +179,8 @@ struct ValidationOptions {
 // not both 0, and a rotation / position where they are used; no fixed_pose
 // together with priors; and a connected graph of poses and landmarks (see
 // ConnectedComponents: with priors, components linked through the world
-// frame count as connected). A landmark seen by a single pose is fine.
+// frame count as connected) whose translational terms are connected too
+// (TranslationalComponents). A landmark seen by a single pose is fine.
 // Returns false with a message otherwise.
 bool ValidatePoseGraph(const PoseGraph& graph, const ValidationOptions& options,
                        std::string* error);

@@ -427,6 +427,13 @@ std::vector<BadLine> BadLines() {
        "disconnected: 2 components of sizes 3, 2; vertex 7"},
       {"LandmarkInA3DFile", kEdge3 + "VERTEX_XY 5 1 2\n", 2,
        "mixed 2D and 3D tags"},
+      {"TiedOnlyByARotationPrior",
+       kEdge + "EDGE_SE2 2 3 1 0 0 1 0 0 1 0 1\n"
+               "EDGE_PRIOR_SE2_XY 0 0 0 1 0 1\n"
+               "EDGE_PRIOR_SE2 3 0 0 0 0 0 0 0 0 1\n",
+       2,
+       "translational terms are disconnected: 2 components; vertex 2 (first "
+       "seen here) is tied to vertex 0 only through rotation priors"},
       {"PriorNoInformation", kEdge + "EDGE_PRIOR_SE2 0 0 0 0 0 0 0 0 0 0\n", 2,
        "the prior carries no information"},
       {"PriorRotationBlockNegative",

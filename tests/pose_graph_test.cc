@@ -238,12 +238,30 @@ TEST(LandmarkValidationTest, ConnectivityCountsLandmarksAndPriors) {
   prior.i = 0;
   anchored.priors.push_back(prior);
   EXPECT_FALSE(ValidatePoseGraph(anchored, AllowLandmarks(), &error));
+  // A rotation-only prior on the other island links it in rotation only:
+  // its translation would be free.
+  PoseGraph rotation_only = anchored;
   prior.i = 3;
   prior.R = Eigen::Matrix2d::Identity();
   prior.kappa = 2;
-  prior.tau = 0;  // A rotation prior connects too.
+  prior.tau = 0;
+  rotation_only.priors.push_back(prior);
+  EXPECT_EQ(ConnectedComponents(rotation_only, nullptr), 1);
+  EXPECT_EQ(TranslationalComponents(rotation_only, nullptr), 2);
+  EXPECT_FALSE(ValidatePoseGraph(rotation_only, AllowLandmarks(), &error));
+  EXPECT_NE(error.find("translational terms are disconnected"),
+            std::string::npos)
+      << error;
+  // A position (or full pose) prior does tie it.
+  prior.tau = 3;
   anchored.priors.push_back(prior);
+  EXPECT_EQ(TranslationalComponents(anchored, nullptr), 1);
   EXPECT_TRUE(ValidatePoseGraph(anchored, AllowLandmarks(), &error)) << error;
+  // Rotation-only priors on a connected graph are fine.
+  PoseGraph rotations = linked;
+  prior.tau = 0;
+  rotations.priors.push_back(prior);
+  EXPECT_TRUE(ValidatePoseGraph(rotations, AllowLandmarks(), &error)) << error;
   EXPECT_EQ(anchored.fixed_pose, -1);
 }
 
