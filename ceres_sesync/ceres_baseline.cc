@@ -100,8 +100,109 @@ class Pose3Residual {
   const double sqrt_kappa_, sqrt_tau_;
 };
 
+// Rotation matrix of a 2D angle.
+template <typename T>
+Eigen::Matrix<T, 2, 2> AngleToRotation(const T* theta) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(theta[0]), s = sin(theta[0]);
+  Eigen::Matrix<T, 2, 2> R;
+  R << c, -s, s, c;
+  return R;
+}
+
+// R(theta) in 2D, R(q) in 3D.
+template <int D, typename T>
+Eigen::Matrix<T, D, D> BlockRotation(const T* r) {
+  if constexpr (D == 2) {
+    return AngleToRotation(r);
+  } else {
+    return QuaternionToRotation(r);
+  }
+}
+
+// Residual of one landmark measurement over (t_i, rotation_i, p_l):
+// sqrt(nu) (p_l - t_i - R_i z).
+template <int D>
+class LandmarkResidual {
+ public:
+  explicit LandmarkResidual(const LandmarkMeasurement& m)
+      : z_(m.z), sqrt_nu_(std::sqrt(m.nu)) {}
+
+  template <typename T>
+  bool operator()(const T* ti, const T* ri, const T* pl, T* residual) const {
+    const Eigen::Matrix<T, D, D> Ri = BlockRotation<D>(ri);
+    const Eigen::Matrix<T, D, 1> e =
+        Eigen::Map<const Eigen::Matrix<T, D, 1>>(pl) -
+        Eigen::Map<const Eigen::Matrix<T, D, 1>>(ti) -
+        Ri * z_.template cast<T>();
+    for (int r = 0; r < D; ++r) residual[r] = sqrt_nu_ * e[r];
+    return true;
+  }
+
+ private:
+  const Eigen::Matrix<double, D, 1> z_;
+  const double sqrt_nu_;
+};
+
+// Rotation part of a prior over rotation_i: sqrt(kappa) vec(R_i - R~).
+template <int D>
+class RotationPriorResidual {
+ public:
+  explicit RotationPriorResidual(const PosePrior& p)
+      : R_(p.R), sqrt_kappa_(std::sqrt(p.kappa)) {}
+
+  template <typename T>
+  bool operator()(const T* ri, T* residual) const {
+    const Eigen::Matrix<T, D, D> E =
+        BlockRotation<D>(ri) - R_.template cast<T>();
+    for (int c = 0; c < D; ++c) {
+      for (int r = 0; r < D; ++r) residual[D * c + r] = sqrt_kappa_ * E(r, c);
+    }
+    return true;
+  }
+
+ private:
+  const Eigen::Matrix<double, D, D> R_;
+  const double sqrt_kappa_;
+};
+
+// Position part of a prior over t_i: sqrt(tau) (t_i - g).
+template <int D>
+class PositionPriorResidual {
+ public:
+  explicit PositionPriorResidual(const PosePrior& p)
+      : g_(p.t), sqrt_tau_(std::sqrt(p.tau)) {}
+
+  template <typename T>
+  bool operator()(const T* ti, T* residual) const {
+    for (int r = 0; r < D; ++r) residual[r] = sqrt_tau_ * (ti[r] - T(g_[r]));
+    return true;
+  }
+
+ private:
+  const Eigen::Matrix<double, D, 1> g_;
+  const double sqrt_tau_;
+};
+
 int GaugePose(const PoseGraph& graph) {
   return graph.fixed_pose >= 0 ? graph.fixed_pose : 0;
+}
+
+// What the Ceres problem holds constant (see BuildCeresProblem).
+struct Gauge {
+  int pose = -1;               // Pose whose translation is held, or -1.
+  bool hold_rotation = false;  // Whether that pose's rotation is held too.
+};
+
+Gauge GaugeOf(const PoseGraph& graph) {
+  if (graph.fixed_pose >= 0 || graph.priors.empty()) {
+    return {GaugePose(graph), true};
+  }
+  for (const PosePrior& p : graph.priors) {
+    if (p.has_position()) return {};  // The priors fix the gauge.
+  }
+  return {0, false};  // Rotation priors only: the translation is free.
 }
 
 // Nearest rotation (Frobenius) to a 3x3 matrix.
@@ -153,7 +254,36 @@ bool CeresPoseBlocks::FromPoses(int d, const Poses& poses, std::string* error) {
   dimension = d;
   translations = std::move(t);
   rotations = std::move(r);
+  landmarks.clear();
   return true;
+}
+
+bool CeresPoseBlocks::FromSolution(int d, const Solution& solution,
+                                   std::string* error) {
+  if (!FromPoses(d, solution.poses, error)) return false;
+  std::vector<double> p(static_cast<size_t>(d) * solution.landmarks.size());
+  for (size_t l = 0; l < solution.landmarks.size(); ++l) {
+    const Eigen::VectorXd& x = solution.landmarks[l];
+    if (x.size() != d || !x.allFinite()) {
+      if (error) {
+        *error = "landmark " + std::to_string(l) +
+                 " is not a finite position of dimension " + std::to_string(d);
+      }
+      return false;
+    }
+    for (int k = 0; k < d; ++k) p[d * l + k] = x[k];
+  }
+  landmarks = std::move(p);
+  return true;
+}
+
+LandmarkPositions CeresPoseBlocks::ToLandmarks() const {
+  LandmarkPositions positions(num_landmarks());
+  for (int l = 0; l < num_landmarks(); ++l) {
+    positions[l] = Eigen::Map<const Eigen::VectorXd>(
+        landmarks.data() + dimension * l, dimension);
+  }
+  return positions;
 }
 
 Poses CeresPoseBlocks::ToPoses() const {
@@ -182,12 +312,16 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
   };
   if (!blocks || !problem) return fail("null blocks or problem");
   std::string why;
-  if (!ValidatePoseGraph(graph, &why))
+  ValidationOptions validation;
+  validation.allow_landmarks_and_priors = true;
+  if (!ValidatePoseGraph(graph, validation, &why))
     return fail("invalid pose graph: " + why);
   const int d = graph.dimension;
   const int n = graph.num_poses;
   if (blocks->dimension != d || blocks->num_poses() != n ||
-      blocks->rotations.size() != static_cast<size_t>(d == 2 ? n : 4 * n)) {
+      blocks->rotations.size() != static_cast<size_t>(d == 2 ? n : 4 * n) ||
+      blocks->landmarks.size() !=
+          static_cast<size_t>(d) * graph.num_landmarks) {
     return fail("parameter blocks do not match the graph's size");
   }
   if (graph.fixed_pose >= n) return fail("fixed_pose is out of range");
@@ -199,6 +333,9 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
       problem->AddParameterBlock(blocks->rotation(i), 4,
                                  new ceres::EigenQuaternionManifold);
     }
+  }
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    problem->AddParameterBlock(blocks->landmark(l), d);
   }
   for (const RelativePoseMeasurement& m : graph.measurements) {
     ceres::CostFunction* cost;
@@ -213,21 +350,86 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
                               blocks->rotation(m.i), blocks->translation(m.j),
                               blocks->rotation(m.j));
   }
-  const int gauge = GaugePose(graph);
-  problem->SetParameterBlockConstant(blocks->translation(gauge));
-  problem->SetParameterBlockConstant(blocks->rotation(gauge));
+  for (const LandmarkMeasurement& m : graph.landmark_measurements) {
+    ceres::CostFunction* cost;
+    if (d == 2) {
+      cost = new ceres::AutoDiffCostFunction<LandmarkResidual<2>, 2, 2, 1, 2>(
+          new LandmarkResidual<2>(m));
+    } else {
+      cost = new ceres::AutoDiffCostFunction<LandmarkResidual<3>, 3, 3, 4, 3>(
+          new LandmarkResidual<3>(m));
+    }
+    problem->AddResidualBlock(cost, nullptr, blocks->translation(m.i),
+                              blocks->rotation(m.i), blocks->landmark(m.l));
+  }
+  for (const PosePrior& p : graph.priors) {
+    if (p.has_rotation()) {
+      ceres::CostFunction* cost;
+      if (d == 2) {
+        cost = new ceres::AutoDiffCostFunction<RotationPriorResidual<2>, 4, 1>(
+            new RotationPriorResidual<2>(p));
+      } else {
+        cost = new ceres::AutoDiffCostFunction<RotationPriorResidual<3>, 9, 4>(
+            new RotationPriorResidual<3>(p));
+      }
+      problem->AddResidualBlock(cost, nullptr, blocks->rotation(p.i));
+    }
+    if (p.has_position()) {
+      ceres::CostFunction* cost;
+      if (d == 2) {
+        cost = new ceres::AutoDiffCostFunction<PositionPriorResidual<2>, 2, 2>(
+            new PositionPriorResidual<2>(p));
+      } else {
+        cost = new ceres::AutoDiffCostFunction<PositionPriorResidual<3>, 3, 3>(
+            new PositionPriorResidual<3>(p));
+      }
+      problem->AddResidualBlock(cost, nullptr, blocks->translation(p.i));
+    }
+  }
+  const Gauge gauge = GaugeOf(graph);
+  if (gauge.pose >= 0) {
+    problem->SetParameterBlockConstant(blocks->translation(gauge.pose));
+    if (gauge.hold_rotation) {
+      problem->SetParameterBlockConstant(blocks->rotation(gauge.pose));
+    }
+  }
   return true;
 }
 
 bool SolveWithCeres(const PoseGraph& graph, const Poses& initial,
                     const CeresBaselineOptions& options, Poses* result,
                     CeresBaselineSummary* summary, std::string* error) {
+  if (graph.num_landmarks > 0) {
+    if (error) {
+      *error =
+          "the graph has landmarks: use the SolveWithCeres overload that "
+          "takes and returns a Solution (poses and landmark positions)";
+    }
+    return false;
+  }
+  Solution solution;
+  if (!SolveWithCeres(graph, Solution{initial, {}}, options,
+                      result ? &solution : nullptr, summary, error)) {
+    return false;
+  }
+  if (result) *result = std::move(solution.poses);
+  return true;
+}
+
+bool SolveWithCeres(const PoseGraph& graph, const Solution& initial,
+                    const CeresBaselineOptions& options, Solution* result,
+                    CeresBaselineSummary* summary, std::string* error) {
   auto fail = [&](const std::string& message) {
     if (error) *error = message;
     return false;
   };
-  if (static_cast<int>(initial.size()) != graph.num_poses) {
+  if (static_cast<int>(initial.poses.size()) != graph.num_poses) {
     return fail("initial poses must have one pose per vertex");
+  }
+  if (static_cast<int>(initial.landmarks.size()) != graph.num_landmarks) {
+    return fail(
+        "initial landmark positions must have one position per "
+        "landmark");
   }
   ceres::Solver::Options solver_options;
   solver_options.minimizer_type = ceres::TRUST_REGION;
@@ -254,8 +456,8 @@ bool SolveWithCeres(const PoseGraph& graph, const Poses& initial,
   }
 
   CeresPoseBlocks blocks;
-  if (!blocks.FromPoses(graph.dimension, initial, &why)) {
-    return fail("invalid initial poses: " + why);
+  if (!blocks.FromSolution(graph.dimension, initial, &why)) {
+    return fail("invalid initial poses or landmarks: " + why);
   }
   ceres::Problem problem;
   if (!BuildCeresProblem(graph, &blocks, &problem, &why)) return fail(why);
@@ -266,7 +468,7 @@ bool SolveWithCeres(const PoseGraph& graph, const Poses& initial,
       !ceres_summary.IsSolutionUsable()) {
     return fail("Ceres failed: " + ceres_summary.message);
   }
-  if (result) *result = blocks.ToPoses();
+  if (result) *result = Solution{blocks.ToPoses(), blocks.ToLandmarks()};
   if (summary) {
     summary->initial_objective = 2 * ceres_summary.initial_cost;
     summary->final_objective = 2 * ceres_summary.final_cost;
@@ -295,15 +497,50 @@ Poses OdometryInitialization(const PoseGraph& graph) {
   if (d != 2 && d != 3) return Poses(n);
   Poses poses = IdentityPoses(d, n);
   if (n == 0) return poses;
-  int root = GaugePose(graph);
-  if (root >= n) root = 0;
   auto valid_pose = [d](const Pose& p) {
     return p.R.rows() == d && p.R.cols() == d && p.t.size() == d;
   };
-  if (static_cast<int>(graph.initial_poses.size()) == n &&
-      valid_pose(graph.initial_poses[root])) {
-    poses[root] = graph.initial_poses[root];
+  const bool has_initial = static_cast<int>(graph.initial_poses.size()) == n;
+  // Roots: the gauge pose, then (for components reached only through the
+  // world frame) every pose with a prior, in prior order.
+  std::vector<int> roots;
+  if (graph.fixed_pose >= 0 && graph.fixed_pose < n) {
+    roots.push_back(graph.fixed_pose);
+  } else if (!graph.priors.empty()) {
+    int root = -1;
+    for (const PosePrior& p : graph.priors) {  // Prefer a full pose prior.
+      if (p.i >= 0 && p.i < n && p.has_rotation() && p.has_position()) {
+        root = p.i;
+        break;
+      }
+    }
+    roots.push_back(root >= 0 ? root : 0);
+  } else {
+    roots.push_back(0);
   }
+  for (const PosePrior& p : graph.priors) {
+    if (p.i >= 0 && p.i < n) roots.push_back(p.i);
+  }
+  // Places a root: its initial pose if there is one, else the identity with
+  // the rotation and position of its first priors.
+  auto place = [&](int root) {
+    if (has_initial && valid_pose(graph.initial_poses[root])) {
+      poses[root] = graph.initial_poses[root];
+      return;
+    }
+    bool rotation = false, position = false;
+    for (const PosePrior& p : graph.priors) {
+      if (p.i != root) continue;
+      if (!rotation && p.has_rotation() && p.R.rows() == d && p.R.cols() == d) {
+        poses[root].R = p.R;
+        rotation = true;
+      }
+      if (!position && p.has_position() && p.t.size() == d) {
+        poses[root].t = p.t;
+        position = true;
+      }
+    }
+  };
   // Adjacency: (measurement index) per pose, in measurement order.
   std::vector<std::vector<int>> adjacent(n);
   for (size_t k = 0; k < graph.measurements.size(); ++k) {
@@ -314,28 +551,52 @@ Poses OdometryInitialization(const PoseGraph& graph) {
     adjacent[m.j].push_back(static_cast<int>(k));
   }
   std::vector<char> visited(n, 0);
-  std::queue<int> queue;
-  queue.push(root);
-  visited[root] = 1;
-  while (!queue.empty()) {
-    const int a = queue.front();
-    queue.pop();
-    for (int k : adjacent[a]) {
-      const RelativePoseMeasurement& m = graph.measurements[k];
-      const int b = m.i == a ? m.j : m.i;
-      if (visited[b]) continue;
-      visited[b] = 1;
-      if (m.i == a) {  // forward: x_j = x_i * x~_ij
-        poses[b].R = poses[a].R * m.R;
-        poses[b].t = poses[a].t + poses[a].R * m.t;
-      } else {  // backward: x_i = x_j * x~_ij^-1
-        poses[b].R = poses[a].R * m.R.transpose();
-        poses[b].t = poses[a].t - poses[b].R * m.t;
+  for (const int root : roots) {
+    if (visited[root]) continue;
+    place(root);
+    std::queue<int> queue;
+    queue.push(root);
+    visited[root] = 1;
+    while (!queue.empty()) {
+      const int a = queue.front();
+      queue.pop();
+      for (int k : adjacent[a]) {
+        const RelativePoseMeasurement& m = graph.measurements[k];
+        const int b = m.i == a ? m.j : m.i;
+        if (visited[b]) continue;
+        visited[b] = 1;
+        if (m.i == a) {  // forward: x_j = x_i * x~_ij
+          poses[b].R = poses[a].R * m.R;
+          poses[b].t = poses[a].t + poses[a].R * m.t;
+        } else {  // backward: x_i = x_j * x~_ij^-1
+          poses[b].R = poses[a].R * m.R.transpose();
+          poses[b].t = poses[a].t - poses[b].R * m.t;
+        }
+        queue.push(b);
       }
-      queue.push(b);
     }
   }
   return poses;
+}
+
+LandmarkPositions InitialLandmarkPositions(const PoseGraph& graph,
+                                           const Poses& poses) {
+  const int d = graph.dimension;
+  const int L = std::max(0, graph.num_landmarks);
+  LandmarkPositions positions(L, Eigen::VectorXd::Zero(std::max(d, 0)));
+  std::vector<char> placed(L, 0);
+  const int n = static_cast<int>(poses.size());
+  for (const LandmarkMeasurement& m : graph.landmark_measurements) {
+    if (m.l < 0 || m.l >= L || placed[m.l] || m.i < 0 || m.i >= n) continue;
+    const Pose& x = poses[m.i];
+    if (x.R.rows() != d || x.R.cols() != d || x.t.size() != d ||
+        m.z.size() != d) {
+      continue;
+    }
+    positions[m.l] = x.t + x.R * m.z;
+    placed[m.l] = 1;
+  }
+  return positions;
 }
 
 }  // namespace ceres_sesync

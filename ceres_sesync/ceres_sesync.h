@@ -5,9 +5,10 @@
 // The public API (each header documents its part):
 //
 //   pose_graph.h              The data model: PoseGraph,
-//   RelativePoseMeasurement,
-//                             Pose/Poses, EvaluateObjective (eq. 12),
-//                             ValidatePoseGraph.
+//                             RelativePoseMeasurement, LandmarkMeasurement,
+//                             PosePrior, Pose/Poses, Solution,
+//                             EvaluateObjective (eq. 12 + landmark and prior
+//                             terms), ValidatePoseGraph.
 //   g2o_io.h                  Reading/writing g2o files, writing TUM
 //                             trajectories.
 //   sesync_solver.h           Solve(): SE-Sync, certifiably correct pose-graph
@@ -25,6 +26,8 @@
 //   cube_generator.h          The synthetic cube benchmark of the paper.
 //   city_generator.h          Large synthetic maps: a Manhattan-style walk
 //                             with loop closures on revisits.
+//   landmark_generator.h      A synthetic landmark-SLAM benchmark (Manhattan
+//                             walk, random landmarks, GPS / start priors).
 //   langevin.h                The isotropic Langevin / von Mises noise
 //                             samplers used by the generators.
 //   stiefel_manifold.h        St(d, r) and St(d, r)^n: free functions and
@@ -44,6 +47,7 @@
 #include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/langevin.h"
 #include "ceres_sesync/pose_conversions.h"
 #include "ceres_sesync/pose_graph.h"

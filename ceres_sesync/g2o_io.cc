@@ -25,16 +25,27 @@ namespace {
 constexpr double kQuaternionTolerance = 1e-2;
 // Normalizations larger than this are counted in the summary.
 constexpr double kQuaternionCountThreshold = 1e-12;
+// The writers' PARAMS_SE3OFFSET: the identity offset, id 0.
+constexpr int64_t kIdentityOffsetId = 0;
 
 enum class Tag {
-  kVertexSE2,    // VERTEX_SE2, VERTEX2
-  kVertexSE3,    // VERTEX_SE3:QUAT
-  kEdgeSE2,      // EDGE_SE2
-  kEdge2,        // EDGE2 (TORO information order)
-  kEdgeSE3,      // EDGE_SE3:QUAT
-  kFix,          // FIX
-  kLegacy3D,     // VERTEX3, EDGE3
-  kUnsupported,  // anything else
+  kVertexSE2,        // VERTEX_SE2, VERTEX2
+  kVertexSE3,        // VERTEX_SE3:QUAT
+  kEdgeSE2,          // EDGE_SE2
+  kEdge2,            // EDGE2 (TORO information order)
+  kEdgeSE3,          // EDGE_SE3:QUAT
+  kVertexXY,         // VERTEX_XY (2D point landmark)
+  kVertexTrackXYZ,   // VERTEX_TRACKXYZ (3D point landmark)
+  kEdgeSE2XY,        // EDGE_SE2_XY (pose -> 2D landmark)
+  kEdgeSE3TrackXYZ,  // EDGE_SE3_TRACKXYZ (pose -> 3D landmark, offset param)
+  kPriorSE2,         // EDGE_PRIOR_SE2 (2D pose prior)
+  kPriorSE2XY,       // EDGE_PRIOR_SE2_XY (2D position prior)
+  kPriorSE3,         // EDGE_SE3_PRIOR (3D pose prior, offset param)
+  kPriorSE3XYZ,      // EDGE_SE3_XYZ_PRIOR (3D position prior, offset param)
+  kParamsSE3Offset,  // PARAMS_SE3OFFSET
+  kFix,              // FIX
+  kLegacy3D,         // VERTEX3, EDGE3
+  kUnsupported,      // anything else
 };
 
 Tag Classify(std::string_view tag) {
@@ -43,6 +54,15 @@ Tag Classify(std::string_view tag) {
   if (tag == "EDGE_SE2") return Tag::kEdgeSE2;
   if (tag == "EDGE2") return Tag::kEdge2;
   if (tag == "EDGE_SE3:QUAT") return Tag::kEdgeSE3;
+  if (tag == "VERTEX_XY") return Tag::kVertexXY;
+  if (tag == "VERTEX_TRACKXYZ") return Tag::kVertexTrackXYZ;
+  if (tag == "EDGE_SE2_XY") return Tag::kEdgeSE2XY;
+  if (tag == "EDGE_SE3_TRACKXYZ") return Tag::kEdgeSE3TrackXYZ;
+  if (tag == "EDGE_PRIOR_SE2") return Tag::kPriorSE2;
+  if (tag == "EDGE_PRIOR_SE2_XY") return Tag::kPriorSE2XY;
+  if (tag == "EDGE_SE3_PRIOR") return Tag::kPriorSE3;
+  if (tag == "EDGE_SE3_XYZ_PRIOR") return Tag::kPriorSE3XYZ;
+  if (tag == "PARAMS_SE3OFFSET") return Tag::kParamsSE3Offset;
   if (tag == "FIX") return Tag::kFix;
   if (tag == "VERTEX3" || tag == "EDGE3") return Tag::kLegacy3D;
   return Tag::kUnsupported;
@@ -53,9 +73,18 @@ int DimensionOf(Tag tag) {
     case Tag::kVertexSE2:
     case Tag::kEdgeSE2:
     case Tag::kEdge2:
+    case Tag::kVertexXY:
+    case Tag::kEdgeSE2XY:
+    case Tag::kPriorSE2:
+    case Tag::kPriorSE2XY:
       return 2;
     case Tag::kVertexSE3:
     case Tag::kEdgeSE3:
+    case Tag::kVertexTrackXYZ:
+    case Tag::kEdgeSE3TrackXYZ:
+    case Tag::kPriorSE3:
+    case Tag::kPriorSE3XYZ:
+    case Tag::kParamsSE3Offset:
       return 3;
     default:
       return 0;
@@ -74,11 +103,46 @@ int FieldCount(Tag tag) {
       return 11;
     case Tag::kEdgeSE3:
       return 30;
+    case Tag::kVertexXY:
+      return 3;  // id x y
+    case Tag::kVertexTrackXYZ:
+      return 4;  // id x y z
+    case Tag::kEdgeSE2XY:
+      return 7;  // pose landmark x y I11 I12 I22
+    case Tag::kEdgeSE3TrackXYZ:
+      return 12;  // pose landmark param x y z I(6)
+    case Tag::kPriorSE2:
+      return 10;  // pose x y theta I(6)
+    case Tag::kPriorSE2XY:
+      return 6;  // pose x y I11 I12 I22
+    case Tag::kPriorSE3:
+      return 30;  // pose param x y z qx qy qz qw I(21)
+    case Tag::kPriorSE3XYZ:
+      return 11;  // pose param x y z I(6)
+    case Tag::kParamsSE3Offset:
+      return 8;  // id x y z qx qy qz qw
     case Tag::kFix:
       return 1;
     default:
       return 0;
   }
+}
+
+bool IsPoseVertex(Tag tag) {
+  return tag == Tag::kVertexSE2 || tag == Tag::kVertexSE3;
+}
+bool IsLandmarkVertex(Tag tag) {
+  return tag == Tag::kVertexXY || tag == Tag::kVertexTrackXYZ;
+}
+bool IsPoseEdge(Tag tag) {
+  return tag == Tag::kEdgeSE2 || tag == Tag::kEdge2 || tag == Tag::kEdgeSE3;
+}
+bool IsLandmarkEdge(Tag tag) {
+  return tag == Tag::kEdgeSE2XY || tag == Tag::kEdgeSE3TrackXYZ;
+}
+bool IsPrior(Tag tag) {
+  return tag == Tag::kPriorSE2 || tag == Tag::kPriorSE2XY ||
+         tag == Tag::kPriorSE3 || tag == Tag::kPriorSE3XYZ;
 }
 
 // Where a message is about, and the error sink.
@@ -302,6 +366,243 @@ bool ParseEdge(const Location& at, Tag tag,
   return true;
 }
 
+// d / tr(I^-1) of a positive definite d x d information block, d = 2 or 3
+// (2D: tr(I^-1) = (I11 + I22) / det).
+double TraceInversePrecision(const Eigen::MatrixXd& info) {
+  if (info.rows() == 2) {
+    const double det = info(0, 0) * info(1, 1) - info(0, 1) * info(0, 1);
+    return 2 * det / (info(0, 0) + info(1, 1));
+  }
+  return 3 / info.inverse().trace();
+}
+
+// The symmetric d x d matrix of the upper-triangle entries u (row by row).
+Eigen::MatrixXd SymmetricFromUpper(const double* u, int d) {
+  Eigen::MatrixXd info(d, d);
+  for (int r = 0; r < d; ++r) {
+    for (int c = r; c < d; ++c) info(r, c) = info(c, r) = *u++;
+  }
+  return info;
+}
+
+bool ParseParameterId(const Location& at,
+                      const std::vector<std::string_view>& tokens, int k,
+                      int64_t* id) {
+  if (!ParseId(tokens[k], id)) {
+    return at.Fail("field " + std::to_string(k) + " '" +
+                   std::string(tokens[k]) +
+                   "' is not a parameter id (a non-negative integer)");
+  }
+  return true;
+}
+
+// A PARAMS_SE3OFFSET: the pose of the sensor in the frame of the robot
+// pose, x_sensor = x_pose * offset.
+struct SensorOffset {
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  int line = 0;
+};
+using SensorOffsets = std::unordered_map<int64_t, SensorOffset>;
+
+// Looks up the offset of parameter field k of an edge line.
+bool FindOffset(const Location& at, const std::vector<std::string_view>& tokens,
+                int k, const SensorOffsets& offsets,
+                const SensorOffset** offset) {
+  int64_t id;
+  if (!ParseParameterId(at, tokens, k, &id)) return false;
+  const auto it = offsets.find(id);
+  if (it == offsets.end()) {
+    return at.Fail("parameter " + std::to_string(id) +
+                   " is not defined: a PARAMS_SE3OFFSET line with this id "
+                   "must come before the edges that use it (as in g2o)");
+  }
+  *offset = &it->second;
+  return true;
+}
+
+// Parses a PARAMS_SE3OFFSET line (id x y z qx qy qz qw).
+bool ParseOffset(const Location& at,
+                 const std::vector<std::string_view>& tokens, int64_t* id,
+                 SensorOffset* offset, int* num_normalized) {
+  if (!ParseParameterId(at, tokens, 1, id)) return false;
+  double v[7];
+  if (!ParseNumbers(at, tokens, 2, 7, v)) return false;
+  offset->t = Eigen::Vector3d(v[0], v[1], v[2]);
+  Eigen::MatrixXd R;
+  if (!RotationFromQuaternion(at, v + 3, &R, num_normalized)) return false;
+  offset->R = R;
+  offset->line = at.line;
+  return true;
+}
+
+// Parses a landmark VERTEX line (id and d coordinates).
+bool ParseLandmarkVertex(const Location& at, Tag tag,
+                         const std::vector<std::string_view>& tokens,
+                         int64_t* id, Eigen::VectorXd* position) {
+  if (!ParseIdField(at, tokens, 1, id)) return false;
+  const int d = tag == Tag::kVertexXY ? 2 : 3;
+  double v[3];
+  if (!ParseNumbers(at, tokens, 2, d, v)) return false;
+  *position = Eigen::Map<const Eigen::VectorXd>(v, d);
+  return true;
+}
+
+// Parses a pose -> landmark edge:
+//   EDGE_SE2_XY pose landmark x y I11 I12 I22
+//   EDGE_SE3_TRACKXYZ pose landmark param x y z I11 I12 I13 I22 I23 I33.
+// g2o's errors are x_pose^-1 p - z (2D) and (x_pose * offset)^-1 p - z (3D),
+// so the measurement in the pose frame is z (2D) and t_off + R_off z (3D);
+// nu = d / tr(I^-1) is unchanged by the rotation R_off.
+bool ParseLandmarkEdge(const Location& at, Tag tag,
+                       const std::vector<std::string_view>& tokens,
+                       const SensorOffsets& offsets, int64_t* pose_id,
+                       int64_t* landmark_id, LandmarkMeasurement* m) {
+  if (!ParseIdField(at, tokens, 1, pose_id) ||
+      !ParseIdField(at, tokens, 2, landmark_id)) {
+    return false;
+  }
+  if (*pose_id == *landmark_id) {
+    return at.Fail("self-loop: vertex " + std::to_string(*pose_id) +
+                   " is both the pose and the landmark of this edge");
+  }
+  const int d = tag == Tag::kEdgeSE2XY ? 2 : 3;
+  const SensorOffset* offset = nullptr;
+  if (d == 3 && !FindOffset(at, tokens, 3, offsets, &offset)) return false;
+  const int first = d == 2 ? 3 : 4;
+  double v[9];
+  if (!ParseNumbers(at, tokens, first, d + d * (d + 1) / 2, v)) return false;
+  m->z = Eigen::Map<const Eigen::VectorXd>(v, d);
+  if (offset) m->z = offset->t + offset->R * m->z;
+  std::string message;
+  if (!TranslationalPrecision(SymmetricFromUpper(v + d, d), &m->nu, &message)) {
+    return at.Fail(message);
+  }
+  return true;
+}
+
+// (kappa, tau) of a pose prior's information matrix (g2o order: position
+// block first): as for edges, except that a block may be exactly zero,
+// meaning no prior on that part (g2o's own initialEstimate reads an all-zero
+// block the same way). Cross terms are not used; priors whose cross terms
+// make the matrix indefinite are counted.
+bool PriorPrecisions(const Location& at, const Eigen::MatrixXd& info,
+                     PosePrior* prior, G2oReadSummary* counts) {
+  const int size = static_cast<int>(info.rows());
+  const int d = size == 3 ? 2 : 3;
+  const Eigen::MatrixXd info_tt = info.topLeftCorner(d, d);
+  const Eigen::MatrixXd info_RR = info.bottomRightCorner(size - d, size - d);
+  const bool no_position = (info_tt.array() == 0).all();
+  const bool no_rotation = (info_RR.array() == 0).all();
+  if (no_position && no_rotation) {
+    return at.Fail(
+        "prior information matrix has zero translational and rotational "
+        "blocks (the prior carries no information)");
+  }
+  prior->tau = 0;
+  prior->kappa = 0;
+  if (!no_position) {
+    if (info_tt.llt().info() != Eigen::Success) {
+      return at.Fail(
+          "translational information block is neither positive definite "
+          "nor zero");
+    }
+    prior->tau = TraceInversePrecision(info_tt);
+  }
+  if (!no_rotation) {
+    if (info_RR.llt().info() != Eigen::Success) {
+      return at.Fail(
+          "rotational information block is neither positive definite nor "
+          "zero");
+    }
+    prior->kappa = d == 2 ? info_RR(0, 0) : 3 / (2 * info_RR.inverse().trace());
+  }
+  if (!(std::isfinite(prior->tau) && prior->tau >= 0 &&
+        std::isfinite(prior->kappa) && prior->kappa >= 0)) {
+    return at.Fail(
+        "information matrix gives non-finite or non-positive precisions");
+  }
+  const bool cross_terms =
+      !(info.topRightCorner(d, size - d).array() == 0).all();
+  if (no_position || no_rotation) {
+    if (cross_terms) ++counts->num_indefinite_information;
+  } else if (info.llt().info() != Eigen::Success) {
+    ++counts->num_indefinite_information;
+  }
+  return true;
+}
+
+// Parses a prior line:
+//   EDGE_PRIOR_SE2 pose x y theta I11 I12 I13 I22 I23 I33
+//   EDGE_PRIOR_SE2_XY pose x y I11 I12 I22
+//   EDGE_SE3_PRIOR pose param x y z qx qy qz qw I11 .. I16 I22 .. I66
+//   EDGE_SE3_XYZ_PRIOR pose param x y z I11 I12 I13 I22 I23 I33.
+// g2o's errors: EDGE_PRIOR_SE2 and EDGE_SE3_PRIOR compare Z^-1 (x * offset)
+// with the identity (translation in Z's frame, so the isotropic tau is that
+// of the world frame); EDGE_PRIOR_SE2_XY and EDGE_SE3_XYZ_PRIOR compare the
+// position with z directly (the latter does not use its offset). An
+// EDGE_SE3_PRIOR offset with a rotation R_off only is applied exactly (R~ =
+// R_Z R_off^T); a translational offset would couple position and rotation,
+// which the model has no term for, and is rejected.
+bool ParsePrior(const Location& at, Tag tag,
+                const std::vector<std::string_view>& tokens,
+                const SensorOffsets& offsets, int64_t* pose_id,
+                PosePrior* prior, G2oReadSummary* counts) {
+  if (!ParseIdField(at, tokens, 1, pose_id)) return false;
+  double v[28];
+  std::string message;
+  switch (tag) {
+    case Tag::kPriorSE2: {
+      if (!ParseNumbers(at, tokens, 2, 9, v)) return false;
+      prior->t = Eigen::Vector2d(v[0], v[1]);
+      prior->R = RotationFromAngle(v[2]);
+      return PriorPrecisions(at, SymmetricFromUpper(v + 3, 3), prior, counts);
+    }
+    case Tag::kPriorSE2XY:
+    case Tag::kPriorSE3XYZ: {
+      const int d = tag == Tag::kPriorSE2XY ? 2 : 3;
+      const SensorOffset* offset = nullptr;
+      if (d == 3 && !FindOffset(at, tokens, 2, offsets, &offset)) {
+        return false;
+      }
+      const int first = d == 2 ? 2 : 3;
+      if (!ParseNumbers(at, tokens, first, d + d * (d + 1) / 2, v)) {
+        return false;
+      }
+      prior->t = Eigen::Map<const Eigen::VectorXd>(v, d);
+      prior->kappa = 0;
+      if (!TranslationalPrecision(SymmetricFromUpper(v + d, d), &prior->tau,
+                                  &message)) {
+        return at.Fail(message);
+      }
+      return true;
+    }
+    case Tag::kPriorSE3: {
+      const SensorOffset* offset = nullptr;
+      if (!FindOffset(at, tokens, 2, offsets, &offset)) return false;
+      if (!(offset->t.array() == 0).all()) {
+        std::ostringstream s;
+        s << "EDGE_SE3_PRIOR with parameter " << tokens[2]
+          << ", whose offset (PARAMS_SE3OFFSET on line " << offset->line
+          << ") has the translation (" << offset->t.transpose()
+          << "): only offsets without translation are supported for pose "
+             "priors";
+        return at.Fail(s.str());
+      }
+      if (!ParseNumbers(at, tokens, 3, 28, v)) return false;
+      prior->t = Eigen::Vector3d(v[0], v[1], v[2]);
+      if (!RotationFromQuaternion(at, v + 3, &prior->R,
+                                  &counts->num_normalized_quaternions)) {
+        return false;
+      }
+      prior->R = prior->R * offset->R.transpose();
+      return PriorPrecisions(at, SymmetricFromUpper(v + 7, 6), prior, counts);
+    }
+    default:
+      return at.Fail("internal error: not a prior tag");
+  }
+}
+
 std::string UnsupportedTagMessage(std::string_view tag) {
   if (Classify(tag) == Tag::kLegacy3D) {
     return "unsupported legacy tag '" + std::string(tag) +
@@ -309,8 +610,11 @@ std::string UnsupportedTagMessage(std::string_view tag) {
            "EDGE_SE3:QUAT)";
   }
   return "unsupported tag '" + std::string(tag) +
-         "' (only SE(2)/SE(3) pose vertices and edges are supported; "
-         "landmarks and priors can be skipped with --skip_unsupported_tags)";
+         "' (supported: SE(2)/SE(3) pose vertices and edges, point landmarks "
+         "VERTEX_XY/EDGE_SE2_XY and VERTEX_TRACKXYZ/EDGE_SE3_TRACKXYZ, pose "
+         "priors EDGE_PRIOR_SE2, EDGE_PRIOR_SE2_XY, EDGE_SE3_PRIOR, "
+         "EDGE_SE3_XYZ_PRIOR, PARAMS_SE3OFFSET and FIX; other lines can be "
+         "skipped with --skip_unsupported_tags)";
 }
 
 // Calls visit(line_number, line) for each line of `text`.
@@ -338,14 +642,34 @@ bool ParseG2oText(std::string_view text, const std::string& name,
 
   int dimension_line = 0;
   std::string dimension_tag;
-  std::vector<int> first_line;  // Per dense index: line of first appearance.
-  struct EdgeIds {
-    int64_t i, j;
+  std::vector<int> first_line;  // Per dense pose index: line of first use.
+  std::vector<int> landmark_first_line;  // The same per landmark.
+  // References to pose ids in file order, resolved to dense indices at the
+  // end: the slot is field `field` (0: i, 1: j) of record `index` of
+  // graph->measurements (kind 0), ->landmark_measurements (1), ->priors (2).
+  struct PoseRef {
+    int64_t id;
+    int line;
+    int kind, index, field;
+  };
+  std::vector<PoseRef> pose_refs;
+  struct LandmarkRef {
+    int64_t id;
     int line;
   };
-  std::vector<EdgeIds> edge_ids;
+  std::vector<LandmarkRef> landmark_refs;  // One per landmark measurement.
+  int first_prior_line = 0;
+  SensorOffsets offsets;
   int64_t fix_id = -1;
   int fix_line = 0;
+
+  // Line of the VERTEX line that defined pose / landmark vertex `id`, or 0.
+  auto vertex_line = [&](int64_t id) {
+    const int pose = graph->FindVertex(id);
+    if (pose >= 0) return first_line[pose];
+    const int landmark = graph->FindLandmark(id);
+    return landmark >= 0 ? landmark_first_line[landmark] : 0;
+  };
 
   std::vector<std::string_view> tokens;
   tokens.reserve(32);
@@ -387,27 +711,86 @@ bool ParseG2oText(std::string_view text, const std::string& name,
                          &counts.num_normalized_quaternions)) {
           return false;
         }
-        const int before = graph->num_poses;
-        const int index = graph->AddVertex(id);
-        if (graph->num_poses == before) {
+        if (const int previous = vertex_line(id); previous != 0) {
           return at.Fail("duplicate VERTEX id " + std::to_string(id) +
-                         " (first defined on line " +
-                         std::to_string(first_line[index]) + ")");
+                         " (first defined on line " + std::to_string(previous) +
+                         ")");
         }
+        graph->AddVertex(id);
         first_line.push_back(number);
         graph->initial_poses.push_back(std::move(pose));
+        return true;
+      }
+      case Tag::kVertexXY:
+      case Tag::kVertexTrackXYZ: {
+        int64_t id;
+        Eigen::VectorXd position;
+        if (!ParseLandmarkVertex(at, tag, tokens, &id, &position)) {
+          return false;
+        }
+        if (const int previous = vertex_line(id); previous != 0) {
+          return at.Fail("duplicate VERTEX id " + std::to_string(id) +
+                         " (first defined on line " + std::to_string(previous) +
+                         ")");
+        }
+        graph->AddLandmark(id);
+        landmark_first_line.push_back(number);
+        graph->initial_landmarks.push_back(std::move(position));
         return true;
       }
       case Tag::kEdgeSE2:
       case Tag::kEdge2:
       case Tag::kEdgeSE3: {
-        EdgeIds ids{0, 0, number};
+        int64_t i, j;
         RelativePoseMeasurement m;
-        if (!ParseEdge(at, tag, tokens, &ids.i, &ids.j, &m, &counts)) {
+        if (!ParseEdge(at, tag, tokens, &i, &j, &m, &counts)) return false;
+        const int index = static_cast<int>(graph->measurements.size());
+        pose_refs.push_back({i, number, 0, index, 0});
+        pose_refs.push_back({j, number, 0, index, 1});
+        graph->measurements.push_back(std::move(m));
+        return true;
+      }
+      case Tag::kEdgeSE2XY:
+      case Tag::kEdgeSE3TrackXYZ: {
+        int64_t i, l;
+        LandmarkMeasurement m;
+        if (!ParseLandmarkEdge(at, tag, tokens, offsets, &i, &l, &m)) {
           return false;
         }
-        edge_ids.push_back(ids);
-        graph->measurements.push_back(std::move(m));
+        const int index = static_cast<int>(graph->landmark_measurements.size());
+        pose_refs.push_back({i, number, 1, index, 0});
+        landmark_refs.push_back({l, number});
+        graph->landmark_measurements.push_back(std::move(m));
+        return true;
+      }
+      case Tag::kPriorSE2:
+      case Tag::kPriorSE2XY:
+      case Tag::kPriorSE3:
+      case Tag::kPriorSE3XYZ: {
+        int64_t i;
+        PosePrior prior;
+        if (!ParsePrior(at, tag, tokens, offsets, &i, &prior, &counts)) {
+          return false;
+        }
+        const int index = static_cast<int>(graph->priors.size());
+        pose_refs.push_back({i, number, 2, index, 0});
+        graph->priors.push_back(std::move(prior));
+        if (first_prior_line == 0) first_prior_line = number;
+        return true;
+      }
+      case Tag::kParamsSE3Offset: {
+        int64_t id;
+        SensorOffset offset;
+        if (!ParseOffset(at, tokens, &id, &offset,
+                         &counts.num_normalized_quaternions)) {
+          return false;
+        }
+        const auto [it, inserted] = offsets.emplace(id, offset);
+        if (!inserted) {
+          return at.Fail("duplicate PARAMS_SE3OFFSET id " + std::to_string(id) +
+                         " (first defined on line " +
+                         std::to_string(it->second.line) + ")");
+        }
         return true;
       }
       case Tag::kFix: {
@@ -432,52 +815,112 @@ bool ParseG2oText(std::string_view text, const std::string& name,
 
   // Where to report problems found at the end of the file.
   at.line = std::max(num_lines, 1);
-  if (graph->measurements.empty()) {
+  if (graph->measurements.empty() && graph->landmark_measurements.empty() &&
+      graph->priors.empty()) {
     return at.Fail(
         "end of file: no EDGE lines (a pose graph needs at least "
         "one measurement)");
   }
 
-  // Resolve the vertex ids of the edges to dense indices.
+  // Resolve the pose ids to dense indices (file order).
   const bool has_vertex_lines = graph->num_poses > 0;
-  for (size_t k = 0; k < edge_ids.size(); ++k) {
-    const EdgeIds& ids = edge_ids[k];
-    RelativePoseMeasurement& m = graph->measurements[k];
-    if (has_vertex_lines) {
-      m.i = graph->FindVertex(ids.i);
-      m.j = graph->FindVertex(ids.j);
-      if (m.i < 0 || m.j < 0) {
-        at.line = ids.line;
-        return at.Fail("edge refers to vertex " +
-                       std::to_string(m.i < 0 ? ids.i : ids.j) +
-                       ", which has no VERTEX line (the file has VERTEX lines "
-                       "for other vertices)");
+  for (const PoseRef& ref : pose_refs) {
+    at.line = ref.line;
+    if (const int landmark = graph->FindLandmark(ref.id); landmark >= 0) {
+      return at.Fail("vertex " + std::to_string(ref.id) +
+                     " is a landmark (line " +
+                     std::to_string(landmark_first_line[landmark]) +
+                     "), but this edge uses it as a pose");
+    }
+    int index = graph->FindVertex(ref.id);
+    if (index < 0) {
+      if (has_vertex_lines) {
+        return at.Fail("edge refers to vertex " + std::to_string(ref.id) +
+                       ", which has no VERTEX line (the file has VERTEX "
+                       "lines for other vertices)");
       }
-    } else {
-      for (int64_t id : {ids.i, ids.j}) {
-        if (graph->FindVertex(id) < 0) first_line.push_back(ids.line);
-        graph->AddVertex(id);
+      index = graph->AddVertex(ref.id);
+      first_line.push_back(ref.line);
+    }
+    switch (ref.kind) {
+      case 0: {
+        RelativePoseMeasurement& m = graph->measurements[ref.index];
+        (ref.field == 0 ? m.i : m.j) = index;
+        break;
       }
-      m.i = graph->FindVertex(ids.i);
-      m.j = graph->FindVertex(ids.j);
+      case 1:
+        graph->landmark_measurements[ref.index].i = index;
+        break;
+      default:
+        graph->priors[ref.index].i = index;
+    }
+  }
+  // Then the landmark ids.
+  const bool has_landmark_vertex_lines = graph->num_landmarks > 0;
+  const char* landmark_tag =
+      graph->dimension == 2 ? "VERTEX_XY" : "VERTEX_TRACKXYZ";
+  std::vector<char> observed(graph->num_landmarks, 0);
+  for (size_t k = 0; k < landmark_refs.size(); ++k) {
+    const LandmarkRef& ref = landmark_refs[k];
+    at.line = ref.line;
+    if (const int pose = graph->FindVertex(ref.id); pose >= 0) {
+      return at.Fail("vertex " + std::to_string(ref.id) + " is a pose (line " +
+                     std::to_string(first_line[pose]) +
+                     "), but this edge uses it as a landmark");
+    }
+    int index = graph->FindLandmark(ref.id);
+    if (index < 0) {
+      if (has_landmark_vertex_lines) {
+        return at.Fail("edge refers to landmark " + std::to_string(ref.id) +
+                       ", which has no " + landmark_tag +
+                       " line (the file has them for other landmarks)");
+      }
+      index = graph->AddLandmark(ref.id);
+      landmark_first_line.push_back(ref.line);
+      observed.push_back(0);
+    }
+    observed[index] = 1;
+    graph->landmark_measurements[k].l = index;
+  }
+  for (int l = 0; l < graph->num_landmarks; ++l) {
+    if (!observed[l]) {
+      at.line = landmark_first_line[l];
+      return at.Fail(
+          std::string("landmark ") + std::to_string(graph->landmark_ids[l]) +
+          " is not observed by any " +
+          (graph->dimension == 2 ? "EDGE_SE2_XY" : "EDGE_SE3_TRACKXYZ") +
+          " line");
     }
   }
 
   if (fix_line != 0) {
+    at.line = fix_line;
     graph->fixed_pose = graph->FindVertex(fix_id);
+    if (graph->FindLandmark(fix_id) >= 0) {
+      return at.Fail("FIX refers to landmark " + std::to_string(fix_id) +
+                     " (only a pose can be fixed)");
+    }
     if (graph->fixed_pose < 0) {
-      at.line = fix_line;
       return at.Fail("FIX refers to vertex " + std::to_string(fix_id) +
                      ", which is not in the graph");
+    }
+    if (!graph->priors.empty()) {
+      return at.Fail(
+          "FIX together with priors (first prior on line " +
+          std::to_string(first_prior_line) +
+          "): the priors fix the gauge, and a fixed vertex on top of them "
+          "would be a hard constraint the model does not have; remove the "
+          "FIX line");
     }
   }
 
   std::vector<int> component;
   const int num_components = ConnectedComponents(*graph, &component);
   if (num_components > 1) {
+    const int n = graph->num_poses;
     std::vector<int> sizes(num_components, 0);
     for (int c : component) ++sizes[c];
-    // The first pose outside the component of pose 0.
+    // The first pose (or landmark) outside the component of pose 0.
     int stray = 0;
     while (component[stray] == component[0]) ++stray;
     std::vector<int> sorted = sizes;
@@ -489,15 +932,36 @@ bool ParseG2oText(std::string_view text, const std::string& name,
       s << (k ? ", " : "") << sorted[k];
     }
     if (num_components > 5) s << ", ...";
-    s << "; vertex " << graph->vertex_ids[stray]
+    s << "; " << (stray < n ? "vertex " : "landmark ")
+      << (stray < n ? graph->vertex_ids[stray] : graph->landmark_ids[stray - n])
       << " (first seen here) is not connected to vertex "
       << graph->vertex_ids[0];
-    at.line = first_line[stray];
+    at.line = stray < n ? first_line[stray] : landmark_first_line[stray - n];
     return at.Fail(s.str());
   }
 
+  if (!graph->priors.empty()) {
+    const int k = TranslationalComponents(*graph, &component);
+    if (k > 1) {
+      const int n = graph->num_poses;
+      int stray = 0;
+      while (component[stray] == component[0]) ++stray;
+      std::ostringstream s;
+      s << "the translational terms are disconnected: " << k << " components; "
+        << (stray < n ? "vertex " : "landmark ")
+        << (stray < n ? graph->vertex_ids[stray]
+                      : graph->landmark_ids[stray - n])
+        << " (first seen here) is tied to vertex " << graph->vertex_ids[0]
+        << " only through rotation priors, so its translation would be free";
+      at.line = stray < n ? first_line[stray] : landmark_first_line[stray - n];
+      return at.Fail(s.str());
+    }
+  }
+
   std::string invalid;
-  if (!ValidatePoseGraph(*graph, &invalid)) {
+  ValidationOptions validation;
+  validation.allow_landmarks_and_priors = true;
+  if (!ValidatePoseGraph(*graph, validation, &invalid)) {
     if (error) *error = name + ": invalid pose graph: " + invalid;
     return false;
   }
@@ -508,6 +972,11 @@ bool ParseG2oText(std::string_view text, const std::string& name,
   if (summary) {
     counts.num_vertices = graph->num_poses;
     counts.num_edges = static_cast<int>(graph->measurements.size());
+    counts.num_landmarks = graph->num_landmarks;
+    counts.num_landmark_edges =
+        static_cast<int>(graph->landmark_measurements.size());
+    counts.num_priors = static_cast<int>(graph->priors.size());
+    counts.num_offset_parameters = static_cast<int>(offsets.size());
     counts.has_fix = fix_line != 0;
     *summary = std::move(counts);
   }
@@ -548,6 +1017,44 @@ bool CheckGraphForWriting(const PoseGraph& graph, std::string* error) {
         m.t.size() != d || !m.R.allFinite() || !m.t.allFinite() ||
         !std::isfinite(m.kappa) || !std::isfinite(m.tau)) {
       return Fail(error, "pose graph has a malformed measurement");
+    }
+  }
+  if (static_cast<int>(graph.landmark_ids.size()) != graph.num_landmarks) {
+    return Fail(error,
+                "pose graph landmark_ids must have one entry per landmark");
+  }
+  for (const auto& m : graph.landmark_measurements) {
+    if (m.i < 0 || m.i >= graph.num_poses || m.l < 0 ||
+        m.l >= graph.num_landmarks || m.z.size() != d || !m.z.allFinite() ||
+        !std::isfinite(m.nu)) {
+      return Fail(error, "pose graph has a malformed landmark measurement");
+    }
+  }
+  for (const auto& p : graph.priors) {
+    if (p.i < 0 || p.i >= graph.num_poses || !std::isfinite(p.kappa) ||
+        !std::isfinite(p.tau) || !(p.has_rotation() || p.has_position()) ||
+        (p.has_rotation() &&
+         (p.R.rows() != d || p.R.cols() != d || !p.R.allFinite())) ||
+        (p.has_position() && (p.t.size() != d || !p.t.allFinite()))) {
+      return Fail(error, "pose graph has a malformed prior");
+    }
+  }
+  return true;
+}
+
+bool CheckLandmarks(const PoseGraph& graph, const LandmarkPositions& landmarks,
+                    std::string* error) {
+  if (static_cast<int>(landmarks.size()) != graph.num_landmarks) {
+    return Fail(error, "expected " + std::to_string(graph.num_landmarks) +
+                           " landmark positions, got " +
+                           std::to_string(landmarks.size()));
+  }
+  for (const Eigen::VectorXd& p : landmarks) {
+    if (p.size() != graph.dimension || !p.allFinite()) {
+      return Fail(error,
+                  "a landmark position is not a finite vector of "
+                  "dimension " +
+                      std::to_string(graph.dimension));
     }
   }
   return true;
@@ -602,7 +1109,97 @@ void AppendVertexLines(const PoseGraph& graph, const Poses& poses,
   }
 }
 
+void AppendLandmarkVertexLines(const PoseGraph& graph,
+                               const LandmarkPositions& landmarks,
+                               std::string* out) {
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    out->append(graph.dimension == 2 ? "VERTEX_XY" : "VERTEX_TRACKXYZ");
+    AppendInt(graph.landmark_ids[l], out);
+    for (int k = 0; k < graph.dimension; ++k) {
+      AppendDouble(landmarks[l](k), out);
+    }
+    out->push_back('\n');
+  }
+}
+
+// The upper triangle of diag(a, .., a (d times), b, .., b (e times)).
+void AppendDiagonalInformation(int d, double a, int e, double b,
+                               std::string* out) {
+  for (int r = 0; r < d + e; ++r) {
+    for (int c = r; c < d + e; ++c) {
+      AppendDouble(r != c ? 0.0 : r < d ? a : b, out);
+    }
+  }
+}
+
+// Landmark measurements and priors, in the tags the reader maps back to the
+// same values (3D ones refer to the identity offset, parameter 0).
+void AppendLandmarkAndPriorLines(const PoseGraph& graph, std::string* out) {
+  const int d = graph.dimension;
+  for (const LandmarkMeasurement& m : graph.landmark_measurements) {
+    out->append(d == 2 ? "EDGE_SE2_XY" : "EDGE_SE3_TRACKXYZ");
+    AppendInt(graph.vertex_ids[m.i], out);
+    AppendInt(graph.landmark_ids[m.l], out);
+    if (d == 3) AppendInt(kIdentityOffsetId, out);
+    for (int k = 0; k < d; ++k) AppendDouble(m.z(k), out);
+    AppendDiagonalInformation(d, m.nu, 0, 0, out);
+    out->push_back('\n');
+  }
+  for (const PosePrior& p : graph.priors) {
+    const int64_t id = graph.vertex_ids[p.i];
+    if (!p.has_rotation()) {  // Position only.
+      out->append(d == 2 ? "EDGE_PRIOR_SE2_XY" : "EDGE_SE3_XYZ_PRIOR");
+      AppendInt(id, out);
+      if (d == 3) AppendInt(kIdentityOffsetId, out);
+      for (int k = 0; k < d; ++k) AppendDouble(p.t(k), out);
+      AppendDiagonalInformation(d, p.tau, 0, 0, out);
+    } else {  // A zero translational block when there is no position prior.
+      const Eigen::VectorXd t =
+          p.has_position() ? p.t : Eigen::VectorXd::Zero(d);
+      out->append(d == 2 ? "EDGE_PRIOR_SE2" : "EDGE_SE3_PRIOR");
+      AppendInt(id, out);
+      if (d == 2) {
+        for (double v : {t(0), t(1), AngleOf(p.R)}) AppendDouble(v, out);
+        AppendDiagonalInformation(2, p.tau, 1, p.kappa, out);
+      } else {
+        AppendInt(kIdentityOffsetId, out);
+        const Eigen::Quaterniond q = QuaternionOf(p.R);
+        for (double v : {t(0), t(1), t(2), q.x(), q.y(), q.z(), q.w()}) {
+          AppendDouble(v, out);
+        }
+        AppendDiagonalInformation(3, p.tau, 3, 2 * p.kappa, out);
+      }
+    }
+    out->push_back('\n');
+  }
+}
+
 }  // namespace
+
+bool TranslationalPrecision(const Eigen::MatrixXd& information, double* nu,
+                            std::string* error) {
+  auto fail = [&](const char* message) {
+    if (error) *error = message;
+    return false;
+  };
+  const int d = static_cast<int>(information.rows());
+  if ((d != 2 && d != 3) || information.cols() != d) {
+    return fail("translational information matrix must be 2 x 2 or 3 x 3");
+  }
+  if (!information.allFinite()) {
+    return fail("information matrix has non-finite entries");
+  }
+  if (information.llt().info() != Eigen::Success) {
+    return fail("translational information matrix is not positive definite");
+  }
+  *nu = TraceInversePrecision(information);
+  if (!(std::isfinite(*nu) && *nu > 0)) {
+    return fail(
+        "information matrix gives a non-finite or non-positive "
+        "precision");
+  }
+  return true;
+}
 
 bool IsotropicPrecisions(const Eigen::MatrixXd& information, double* kappa,
                          double* tau, std::string* error) {
@@ -627,16 +1224,8 @@ bool IsotropicPrecisions(const Eigen::MatrixXd& information, double* kappa,
   if (info_RR.llt().info() != Eigen::Success) {
     return fail("rotational information block is not positive definite");
   }
-  if (d == 2) {
-    // tr([[I11, I12], [I12, I22]]^-1) = (I11 + I22) / det.
-    const double det =
-        info_tt(0, 0) * info_tt(1, 1) - info_tt(0, 1) * info_tt(0, 1);
-    *tau = 2 * det / (info_tt(0, 0) + info_tt(1, 1));
-    *kappa = info_RR(0, 0);
-  } else {
-    *tau = 3 / info_tt.inverse().trace();
-    *kappa = 3 / (2 * info_RR.inverse().trace());
-  }
+  *tau = TraceInversePrecision(info_tt);
+  *kappa = d == 2 ? info_RR(0, 0) : 3 / (2 * info_RR.inverse().trace());
   if (!(std::isfinite(*tau) && *tau > 0 && std::isfinite(*kappa) &&
         *kappa > 0)) {
     return fail(
@@ -665,11 +1254,29 @@ bool ReadG2o(std::istream& in, const std::string& name_for_messages,
 
 bool WriteG2oFile(const std::string& path, const PoseGraph& graph,
                   const Poses& poses, std::string* error) {
+  return WriteG2oFile(path, graph, poses, {}, error);
+}
+
+bool WriteG2oFile(const std::string& path, const PoseGraph& graph,
+                  const Poses& poses, const LandmarkPositions& landmarks,
+                  std::string* error) {
   if (!CheckGraphForWriting(graph, error)) return false;
   if (!poses.empty() && !CheckPoses(graph, poses, error)) return false;
+  if (!landmarks.empty() && !CheckLandmarks(graph, landmarks, error)) {
+    return false;
+  }
   std::string out;
-  out.reserve(64 * graph.num_poses + 256 * graph.measurements.size());
+  out.reserve(64 * graph.num_poses + 256 * graph.measurements.size() +
+              64 * graph.num_landmarks +
+              96 * (graph.landmark_measurements.size() + graph.priors.size()));
+  if (graph.dimension == 3 &&
+      (!graph.landmark_measurements.empty() || !graph.priors.empty())) {
+    out.append("PARAMS_SE3OFFSET");
+    AppendInt(kIdentityOffsetId, &out);
+    out.append(" 0 0 0 0 0 0 1\n");
+  }
   if (!poses.empty()) AppendVertexLines(graph, poses, &out);
+  if (!landmarks.empty()) AppendLandmarkVertexLines(graph, landmarks, &out);
   for (const auto& m : graph.measurements) {
     if (graph.dimension == 2) {
       out.append("EDGE_SE2");
@@ -696,6 +1303,7 @@ bool WriteG2oFile(const std::string& path, const PoseGraph& graph,
     }
     out.push_back('\n');
   }
+  AppendLandmarkAndPriorLines(graph, &out);
   if (graph.fixed_pose >= 0) {
     if (graph.fixed_pose >= graph.num_poses) {
       return Fail(error, "pose graph fixed_pose is out of range");
@@ -718,8 +1326,29 @@ bool WriteG2oPoses(const std::string& path, const PoseGraph& graph,
   return internal::WriteFileAtomically(path, out, error);
 }
 
-bool ReadG2oPoses(const std::string& path, const PoseGraph& graph, Poses* poses,
-                  std::string* error) {
+bool WriteG2oSolution(const std::string& path, const PoseGraph& graph,
+                      const Solution& solution, std::string* error) {
+  if (!CheckGraphForWriting(graph, error) ||
+      !CheckPoses(graph, solution.poses, error) ||
+      !CheckLandmarks(graph, solution.landmarks, error)) {
+    return false;
+  }
+  std::string out;
+  out.reserve(96 * graph.num_poses + 64 * graph.num_landmarks);
+  AppendVertexLines(graph, solution.poses, &out);
+  AppendLandmarkVertexLines(graph, solution.landmarks, &out);
+  return internal::WriteFileAtomically(path, out, error);
+}
+
+namespace {
+
+// Reads the pose VERTEX lines of `path` into `poses` and, if `landmarks` is
+// not null, the landmark VERTEX lines into `landmarks` (else they are
+// ignored), matched by id to `graph`. Edge, prior, parameter and FIX lines
+// are ignored.
+bool ReadVertexFile(const std::string& path, const PoseGraph& graph,
+                    Poses* poses, LandmarkPositions* landmarks,
+                    std::string* error) {
   if (graph.dimension != 2 && graph.dimension != 3) {
     return Fail(error, "pose graph dimension must be 2 or 3");
   }
@@ -727,7 +1356,9 @@ bool ReadG2oPoses(const std::string& path, const PoseGraph& graph, Poses* poses,
   if (!internal::ReadFileToString(path, &text, error)) return false;
   Location at{path, 0, error};
   std::vector<int> line_of_pose(graph.num_poses, 0);
+  std::vector<int> line_of_landmark(landmarks ? graph.num_landmarks : 0, 0);
   Poses result(graph.num_poses);
+  LandmarkPositions positions(line_of_landmark.size());
   int num_normalized = 0;
   std::vector<std::string_view> tokens;
   auto visit = [&](int number, std::string_view line) {
@@ -735,11 +1366,12 @@ bool ReadG2oPoses(const std::string& path, const PoseGraph& graph, Poses* poses,
     Tokenize(line, &tokens);
     if (tokens.empty() || tokens[0][0] == '#') return true;
     const Tag tag = Classify(tokens[0]);
-    if (tag == Tag::kEdgeSE2 || tag == Tag::kEdge2 || tag == Tag::kEdgeSE3 ||
-        tag == Tag::kFix) {
+    if (IsPoseEdge(tag) || IsLandmarkEdge(tag) || IsPrior(tag) ||
+        tag == Tag::kParamsSE3Offset || tag == Tag::kFix ||
+        (IsLandmarkVertex(tag) && !landmarks)) {
       return true;  // Only the vertices matter here.
     }
-    if (tag != Tag::kVertexSE2 && tag != Tag::kVertexSE3) {
+    if (!IsPoseVertex(tag) && !IsLandmarkVertex(tag)) {
       return at.Fail(UnsupportedTagMessage(tokens[0]));
     }
     if (DimensionOf(tag) != graph.dimension) {
@@ -748,6 +1380,23 @@ bool ReadG2oPoses(const std::string& path, const PoseGraph& graph, Poses* poses,
     }
     if (!CheckFieldCount(at, tokens, FieldCount(tag))) return false;
     int64_t id;
+    if (IsLandmarkVertex(tag)) {
+      Eigen::VectorXd position;
+      if (!ParseLandmarkVertex(at, tag, tokens, &id, &position)) return false;
+      const int index = graph.FindLandmark(id);
+      if (index < 0) {
+        return at.Fail("vertex " + std::to_string(id) +
+                       " is not a landmark of the pose graph");
+      }
+      if (line_of_landmark[index] != 0) {
+        return at.Fail("duplicate VERTEX id " + std::to_string(id) +
+                       " (first defined on line " +
+                       std::to_string(line_of_landmark[index]) + ")");
+      }
+      line_of_landmark[index] = number;
+      positions[index] = std::move(position);
+      return true;
+    }
     Pose pose;
     if (!ParseVertex(at, tag, tokens, &id, &pose, &num_normalized))
       return false;
@@ -767,19 +1416,48 @@ bool ReadG2oPoses(const std::string& path, const PoseGraph& graph, Poses* poses,
   };
   int num_lines = 0;
   if (!ForEachLine(text, &num_lines, visit)) return false;
+  at.line = std::max(num_lines, 1);
   const int missing =
       static_cast<int>(std::count(line_of_pose.begin(), line_of_pose.end(), 0));
   if (missing > 0) {
     const int first = static_cast<int>(
         std::find(line_of_pose.begin(), line_of_pose.end(), 0) -
         line_of_pose.begin());
-    at.line = std::max(num_lines, 1);
     return at.Fail("end of file: no VERTEX line for vertex " +
                    std::to_string(graph.vertex_ids[first]) + " (" +
                    std::to_string(missing) + " of " +
                    std::to_string(graph.num_poses) + " poses missing)");
   }
+  const int missing_landmarks = static_cast<int>(
+      std::count(line_of_landmark.begin(), line_of_landmark.end(), 0));
+  if (missing_landmarks > 0) {
+    const int first = static_cast<int>(
+        std::find(line_of_landmark.begin(), line_of_landmark.end(), 0) -
+        line_of_landmark.begin());
+    return at.Fail("end of file: no VERTEX line for landmark " +
+                   std::to_string(graph.landmark_ids[first]) + " (" +
+                   std::to_string(missing_landmarks) + " of " +
+                   std::to_string(graph.num_landmarks) + " landmarks missing)");
+  }
   *poses = std::move(result);
+  if (landmarks) *landmarks = std::move(positions);
+  return true;
+}
+
+}  // namespace
+
+bool ReadG2oPoses(const std::string& path, const PoseGraph& graph, Poses* poses,
+                  std::string* error) {
+  return ReadVertexFile(path, graph, poses, nullptr, error);
+}
+
+bool ReadG2oSolution(const std::string& path, const PoseGraph& graph,
+                     Solution* solution, std::string* error) {
+  Solution result;
+  if (!ReadVertexFile(path, graph, &result.poses, &result.landmarks, error)) {
+    return false;
+  }
+  *solution = std::move(result);
   return true;
 }
 

@@ -1,8 +1,11 @@
 #include "ceres_sesync/pose_graph.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
+#include <unordered_set>
 
 #include "Eigen/LU"
 
@@ -22,6 +25,21 @@ int PoseGraph::FindVertex(int64_t vertex_id) const {
   return it == index_of_vertex_id.end() ? -1 : it->second;
 }
 
+int PoseGraph::AddLandmark(int64_t landmark_id) {
+  auto [it, inserted] =
+      index_of_landmark_id.emplace(landmark_id, num_landmarks);
+  if (inserted) {
+    landmark_ids.push_back(landmark_id);
+    ++num_landmarks;
+  }
+  return it->second;
+}
+
+int PoseGraph::FindLandmark(int64_t landmark_id) const {
+  auto it = index_of_landmark_id.find(landmark_id);
+  return it == index_of_landmark_id.end() ? -1 : it->second;
+}
+
 namespace {
 int FindRoot(std::vector<int>& parent, int x) {
   while (parent[x] != x) x = parent[x] = parent[parent[x]];
@@ -37,17 +55,35 @@ bool IsRotation(const Eigen::MatrixXd& R, int d, double tolerance) {
 }
 }  // namespace
 
-int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
+namespace {
+
+// Components of poses and landmarks linked by the measurements, landmark
+// measurements and priors; with `translations_only`, priors link their pose
+// to the world node only if they have a position term.
+int Components(const PoseGraph& graph, bool translations_only,
+               std::vector<int>* component) {
   const int n = graph.num_poses;
-  std::vector<int> parent(n);
+  const int L = std::max(graph.num_landmarks, 0);
+  // Nodes: poses 0..n-1, landmarks n..n+L-1, the world node n+L.
+  const int world = n + L;
+  std::vector<int> parent(world + 1);
   std::iota(parent.begin(), parent.end(), 0);
+  auto unite = [&](int a, int b) {
+    parent[FindRoot(parent, a)] = FindRoot(parent, b);
+  };
+  auto is_pose = [n](int i) { return i >= 0 && i < n; };
   for (const auto& e : graph.measurements) {
-    if (e.i < 0 || e.j < 0 || e.i >= n || e.j >= n) continue;
-    parent[FindRoot(parent, e.i)] = FindRoot(parent, e.j);
+    if (is_pose(e.i) && is_pose(e.j)) unite(e.i, e.j);
   }
-  std::vector<int> label(n, -1), root_label(n, -1);
+  for (const auto& o : graph.landmark_measurements) {
+    if (is_pose(o.i) && o.l >= 0 && o.l < L) unite(o.i, n + o.l);
+  }
+  for (const auto& p : graph.priors) {
+    if (is_pose(p.i) && (!translations_only || p.tau > 0)) unite(p.i, world);
+  }
+  std::vector<int> label(n + L, -1), root_label(world + 1, -1);
   int k = 0;
-  for (int v = 0; v < n; ++v) {
+  for (int v = 0; v < n + L; ++v) {
     const int root = FindRoot(parent, v);
     if (root_label[root] < 0) root_label[root] = k++;
     label[v] = root_label[root];
@@ -56,7 +92,23 @@ int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
   return k;
 }
 
+}  // namespace
+
+int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
+  return Components(graph, false, component);
+}
+
+int TranslationalComponents(const PoseGraph& graph,
+                            std::vector<int>* component) {
+  return Components(graph, true, component);
+}
+
 bool ValidatePoseGraph(const PoseGraph& graph, std::string* error) {
+  return ValidatePoseGraph(graph, ValidationOptions(), error);
+}
+
+bool ValidatePoseGraph(const PoseGraph& graph, const ValidationOptions& options,
+                       std::string* error) {
   auto fail = [&](const std::string& message) {
     if (error) *error = message;
     return false;
@@ -102,22 +154,145 @@ bool ValidatePoseGraph(const PoseGraph& graph, std::string* error) {
       }
     }
   }
+
+  // Landmarks.
+  const int L = graph.num_landmarks;
+  if (L < 0) return fail("num_landmarks is negative");
+  if (static_cast<int>(graph.landmark_ids.size()) != L) {
+    return fail("landmark_ids must have one entry per landmark");
+  }
+  if (L > 0) {
+    std::unordered_set<int64_t> ids(graph.vertex_ids.begin(),
+                                    graph.vertex_ids.end());
+    for (int64_t id : graph.landmark_ids) {
+      if (!ids.insert(id).second) {
+        return fail("landmark id " + std::to_string(id) +
+                    " is used twice or is also a pose id (poses and "
+                    "landmarks share one id space)");
+      }
+    }
+  }
+  std::vector<char> observed(L, 0);
+  for (size_t k = 0; k < graph.landmark_measurements.size(); ++k) {
+    const auto& o = graph.landmark_measurements[k];
+    auto where = [&] {
+      return "landmark measurement " + std::to_string(k) + " (pose " +
+             std::to_string(o.i) + " -> landmark " + std::to_string(o.l) +
+             "): ";
+    };
+    if (o.i < 0 || o.i >= graph.num_poses) {
+      return fail(where() + "pose index out of range");
+    }
+    if (o.l < 0 || o.l >= L) {
+      return fail(where() + "landmark index out of range");
+    }
+    if (o.z.size() != d || !o.z.allFinite()) {
+      return fail(where() + "measurement is not a finite d-vector");
+    }
+    if (!(std::isfinite(o.nu) && o.nu > 0)) {
+      return fail(where() + "nu must be finite and positive");
+    }
+    observed[o.l] = 1;
+  }
+  for (int l = 0; l < L; ++l) {
+    if (!observed[l]) {
+      return fail("landmark " + std::to_string(graph.landmark_ids[l]) +
+                  " is not observed by any pose");
+    }
+  }
+  if (!graph.initial_landmarks.empty()) {
+    if (static_cast<int>(graph.initial_landmarks.size()) != L) {
+      return fail(
+          "initial_landmarks must be empty or have one position per "
+          "landmark");
+    }
+    for (const auto& p : graph.initial_landmarks) {
+      if (p.size() != d || !p.allFinite()) {
+        return fail("an initial landmark position is not a finite d-vector");
+      }
+    }
+  }
+
+  // Priors.
+  for (size_t k = 0; k < graph.priors.size(); ++k) {
+    const auto& p = graph.priors[k];
+    auto where = [&] {
+      return "prior " + std::to_string(k) + " (pose " + std::to_string(p.i) +
+             "): ";
+    };
+    if (p.i < 0 || p.i >= graph.num_poses) {
+      return fail(where() + "pose index out of range");
+    }
+    if (!(std::isfinite(p.kappa) && p.kappa >= 0 && std::isfinite(p.tau) &&
+          p.tau >= 0 && (p.kappa > 0 || p.tau > 0))) {
+      return fail(where() +
+                  "kappa and tau must be finite and non-negative, and not "
+                  "both zero");
+    }
+    if (p.has_rotation() && !IsRotation(p.R, d, 1e-6)) {
+      return fail(where() + "rotation is not in SO(d)");
+    }
+    if (p.has_position() && (p.t.size() != d || !p.t.allFinite())) {
+      return fail(where() + "position is not a finite d-vector");
+    }
+  }
+  if (!graph.priors.empty() && graph.fixed_pose >= 0) {
+    return fail(
+        "fixed_pose (FIX) together with priors: the priors fix the gauge, "
+        "and a fixed pose on top of them would be a hard constraint, which "
+        "the model does not have");
+  }
+
   const int k = ConnectedComponents(graph, nullptr);
   if (k != 1) {
     std::ostringstream s;
     s << "measurement graph is disconnected: " << k << " components";
     return fail(s.str());
   }
+  if (!graph.priors.empty()) {  // Else the same as ConnectedComponents.
+    const int kt = TranslationalComponents(graph, nullptr);
+    if (kt != 1) {
+      std::ostringstream s;
+      s << "the translational terms are disconnected: " << kt
+        << " components (a part tied to the rest only by rotation priors "
+           "would have a free translation)";
+      return fail(s.str());
+    }
+  }
+  if (!options.allow_landmarks_and_priors && graph.has_landmarks_or_priors()) {
+    std::ostringstream s;
+    s << "the graph has " << L << " landmarks, "
+      << graph.landmark_measurements.size() << " landmark measurements and "
+      << graph.priors.size()
+      << " priors; Solve, Certify and the chordal initialization do not "
+         "support landmarks and priors yet (issue #15), only the Ceres "
+         "baseline (ceres_baseline.h) does";
+    return fail(s.str());
+  }
   return true;
 }
 
-double EvaluateObjective(const PoseGraph& graph, const Poses& poses) {
+double EvaluateObjective(const PoseGraph& graph, const Poses& poses,
+                         const LandmarkPositions& landmarks) {
+  if (static_cast<int>(poses.size()) != graph.num_poses ||
+      static_cast<int>(landmarks.size()) != graph.num_landmarks) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
   double f = 0;
   for (const auto& e : graph.measurements) {
     const Pose& a = poses[e.i];
     const Pose& b = poses[e.j];
     f += e.kappa * (b.R - a.R * e.R).squaredNorm() +
          e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
+  }
+  for (const auto& o : graph.landmark_measurements) {
+    const Pose& a = poses[o.i];
+    f += o.nu * (landmarks[o.l] - a.t - a.R * o.z).squaredNorm();
+  }
+  for (const auto& p : graph.priors) {
+    const Pose& a = poses[p.i];
+    if (p.has_rotation()) f += p.kappa * (a.R - p.R).squaredNorm();
+    if (p.has_position()) f += p.tau * (a.t - p.t).squaredNorm();
   }
   return f;
 }

@@ -86,10 +86,11 @@ std::vector<Input> Inputs() {
        "has norm"},
       // Skipped tags around an otherwise valid file; without skipping, an
       // error naming the tag.
-      {"skipped", "VERTEX_XY 3 1 2\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n", true,
-       true, ""},
-      {"not_skipped", "VERTEX_XY 3 1 2\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n",
-       false, false, "unsupported tag 'VERTEX_XY'"},
+      {"skipped", "EDGE_PRIOR_XY 3 1 2 1 0 1\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n",
+       true, true, ""},
+      {"not_skipped",
+       "EDGE_PRIOR_XY 3 1 2 1 0 1\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n", false,
+       false, "unsupported tag 'EDGE_PRIOR_XY'"},
       // A skipped line never hides a legacy 3D tag.
       {"legacy_3d", "EDGE3 0 1 0 0 0 0 0 0\n", true, false, "legacy"},
       // FIX of a vertex that is not in the graph.
@@ -121,8 +122,14 @@ TEST(G2oFuzzRegressions, RecordedOutcomesAndInvariants) {
       continue;
     }
     std::string invalid;
-    EXPECT_TRUE(ValidatePoseGraph(g, &invalid)) << invalid;
+    ValidationOptions validation;
+    validation.allow_landmarks_and_priors = true;
+    EXPECT_TRUE(ValidatePoseGraph(g, validation, &invalid)) << invalid;
     EXPECT_EQ(summary.num_vertices, g.num_poses);
+    EXPECT_EQ(summary.num_landmarks, g.num_landmarks);
+    EXPECT_EQ(summary.num_landmark_edges,
+              static_cast<int>(g.landmark_measurements.size()));
+    EXPECT_EQ(summary.num_priors, static_cast<int>(g.priors.size()));
     EXPECT_EQ(summary.num_edges, static_cast<int>(g.measurements.size()));
     EXPECT_EQ(summary.has_fix, g.fixed_pose >= 0);
     if (summary.num_skipped_lines == 0) {

@@ -302,10 +302,10 @@ TEST(G2oReadTest, SkipOptionCountsUnsupportedLines) {
   const std::string text =
       "VERTEX_SE2 0 0 0 0\n"
       "VERTEX_SE2 1 0 0 0\n"
-      "VERTEX_XY 100 1 2\n"
+      "EDGE_PRIOR_XY 100 1 2 1 0 1\n"
       "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
-      "EDGE_SE2_XY 0 100 1 2 1 0 1\n"
-      "EDGE_SE2_XY 1 100 1 2 1 0 1\n";
+      "EDGE_BEARING_SE2_XY 0 100 0.5 1\n"
+      "EDGE_BEARING_SE2_XY 1 100 0.25 1\n";
   G2oReadOptions options;
   options.skip_unsupported_tags = true;
   G2oReadSummary summary;
@@ -313,8 +313,8 @@ TEST(G2oReadTest, SkipOptionCountsUnsupportedLines) {
   EXPECT_EQ(graph.num_poses, 2);
   EXPECT_EQ(graph.measurements.size(), 1u);
   EXPECT_EQ(summary.num_skipped_lines, 3);
-  EXPECT_EQ(summary.skipped_tags["VERTEX_XY"], 1);
-  EXPECT_EQ(summary.skipped_tags["EDGE_SE2_XY"], 2);
+  EXPECT_EQ(summary.skipped_tags["EDGE_PRIOR_XY"], 1);
+  EXPECT_EQ(summary.skipped_tags["EDGE_BEARING_SE2_XY"], 2);
 }
 
 TEST(G2oReadTest, ReadsFromAStream) {
@@ -360,11 +360,11 @@ std::vector<BadInput> BadInputs() {
       e3 + "EDGE_SE3:QUAT 1 2 1 0 0 0 0 0 0 1 0 0 0 0 0 1 0 0 0 0 1 0 0 0 1 "
            "0 0 1 0 1\n",  // zero quaternion
       e3 + "EDGE_SE3:QUAT 1 2 1 0 0 0 0 0 1 1 0 0 0 0 0 1 0 0 0 0 1 0 0 0 1 "
-           "2 0 1 0 1\n",                      // 3D I_RR not PD
-      e + e3,                                  // mixed 2D/3D
-      e + "EDGE_SE2 2 2 1 0 0 1 0 0 1 0 1\n",  // self-loop
-      e + "EDGE_FOO 1 2\n",                    // unknown tag
-      e + "EDGE_SE3_PRIOR 1 0 0 0 0 0 0 1\n",  // prior
+           "2 0 1 0 1\n",                               // 3D I_RR not PD
+      e + e3,                                           // mixed 2D/3D
+      e + "EDGE_SE2 2 2 1 0 0 1 0 0 1 0 1\n",           // self-loop
+      e + "EDGE_FOO 1 2\n",                             // unknown tag
+      e + "EDGE_POINTXYZ_PRIOR 1 0 0 0 1 0 0 1 0 1\n",  // landmark prior
       e3 + "EDGE3 1 2 1 0 0 0 0 0 1 0 0 0 0 0 1 0 0 0 0 1 0 0 0 1 0 0 1 0 1\n",
       "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\n" + e +
           "EDGE_SE2 1 2 1 0 0 1 0 0 1 0 1\n",  // missing vertex
@@ -398,7 +398,8 @@ std::vector<BadInput> BadInputs() {
       {"Mixed2D3D", texts[13].c_str(), 2, "mixed 2D and 3D"},
       {"SelfLoop", texts[14].c_str(), 2, "self-loop"},
       {"UnknownTag", texts[15].c_str(), 2, "unsupported tag 'EDGE_FOO'"},
-      {"PriorTag", texts[16].c_str(), 2, "unsupported tag 'EDGE_SE3_PRIOR'"},
+      {"LandmarkPriorTag", texts[16].c_str(), 2,
+       "unsupported tag 'EDGE_POINTXYZ_PRIOR'"},
       {"LegacyEdge3", texts[17].c_str(), 2, "unsupported legacy tag 'EDGE3'"},
       {"EdgeToMissingVertex", texts[18].c_str(), 4,
        "vertex 2, which has no VERTEX line"},

@@ -363,15 +363,16 @@ TEST_F(InfoCommandTest, BadFileExitsWithTwoNamingTheLineAndWritesNoJson) {
 }
 
 TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
-  const std::string graph = TempPath("landmarks.g2o");
-  const std::string json_path = TempPath("landmarks.json");
+  const std::string graph = TempPath("bearing.g2o");
+  const std::string json_path = TempPath("bearing.json");
   WriteText(graph,
             "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
-            "VERTEX_XY 5 1 2\n");
+            "EDGE_BEARING_SE2_XY 0 5 0.5 1\n");
   RunResult run = RunTool("info " + graph);
   EXPECT_EQ(run.exit_code, 2) << run.output;
-  EXPECT_NE(run.output.find(graph + ":2: unsupported tag 'VERTEX_XY'"),
-            std::string::npos)
+  EXPECT_NE(
+      run.output.find(graph + ":2: unsupported tag 'EDGE_BEARING_SE2_XY'"),
+      std::string::npos)
       << run.output;
 
   run =
@@ -381,7 +382,40 @@ TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
   const std::string json = ReadText(json_path);
   EXPECT_TRUE(IsValidJson(json)) << json;
   EXPECT_NE(json.find("\"num_skipped_lines\": 1"), std::string::npos) << json;
-  EXPECT_NE(json.find("\"VERTEX_XY\": 1"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"EDGE_BEARING_SE2_XY\": 1"), std::string::npos) << json;
+  fs::remove(graph);
+  fs::remove(json_path);
+}
+
+TEST_F(InfoCommandTest, CountsLandmarksAndPriors) {
+  const std::string graph = TempPath("landmarks.g2o");
+  const std::string json_path = TempPath("landmarks.json");
+  // Two landmarks (4 I and 2 I: nu 4 and 2), three measurements, one prior
+  // of each kind.
+  WriteText(graph,
+            "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
+            "EDGE_SE2_XY 0 10 1 2 4 0 4\n"
+            "EDGE_SE2_XY 1 10 0 2 4 0 4\n"
+            "EDGE_SE2_XY 1 11 0 2 2 0 2\n"
+            "EDGE_PRIOR_SE2_XY 0 0 0 9 0 9\n"
+            "EDGE_PRIOR_SE2 1 1 0 0 0 0 0 0 0 3\n"
+            "EDGE_PRIOR_SE2 0 0 0 0 1 0 0 1 0 3\n");
+  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "landmarks:"), "2") << run.output;
+  EXPECT_EQ(ValueAfter(run.output, "landmark measurements:"), "3");
+  EXPECT_EQ(ValueAfter(run.output, "nu min / median / max:"), "2 / 4 / 4");
+  EXPECT_EQ(ValueAfter(run.output, "priors:"),
+            "3 (position 1, rotation 1, pose 1)");
+  const std::string json = ReadText(json_path);
+  EXPECT_TRUE(IsValidJson(json)) << json;
+  for (const char* field :
+       {"\"num_landmarks\": 2", "\"num_landmark_measurements\": 3",
+        "\"num_priors\": 3", "\"position\": 1", "\"rotation\": 1",
+        "\"pose\": 1", "\"has_initial_landmarks\": false"}) {
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+  }
+  EXPECT_NEAR(JsonNumber(json, "\"nu\"", "min"), 2, 1e-14);
   fs::remove(graph);
   fs::remove(json_path);
 }

@@ -36,8 +36,8 @@ const Command kCommands[] = {
     {"certify", ceres_sesync::tools::RunCertify,
      "certify GRAPH.g2o POSES.g2o [--json C.json]"},
     {"generate", ceres_sesync::tools::RunGenerate,
-     "generate cube --side S | city --poses N [--dimension 2|3] --output "
-     "FILE.g2o [...]"},
+     "generate cube --side S | city --poses N | landmarks [--dimension 2|3] "
+     "--output FILE.g2o [...]"},
 };
 
 std::string Usage() {

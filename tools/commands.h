@@ -31,6 +31,9 @@ int RunInfo(const Args& args);
 int RunSolve(const Args& args);
 int RunCertify(const Args& args);
 int RunGenerate(const Args& args);
+// `generate landmarks` (generate_landmarks_command.cc); `args` starts with
+// "landmarks".
+int RunGenerateLandmarks(const Args& args);
 
 // --proof_arithmetic: "automatic", "double" or "double-double"; false for
 // anything else.

@@ -1,6 +1,7 @@
 // `ceres_sesync generate cube|city ...`: writes a synthetic pose graph: the
 // cube (or 2D grid) of SE-Sync's Section 6.1 (ceres_sesync/cube_generator.h)
 // or a large Manhattan-style city walk (ceres_sesync/city_generator.h).
+// `generate landmarks ...` is in generate_landmarks_command.cc.
 
 #include <algorithm>
 #include <cmath>
@@ -83,10 +84,13 @@ Poses DeadReckoning(const PoseGraph& graph) {
 }  // namespace
 
 int RunGenerate(const Args& args) {
-  if (args.empty()) return UsageError("missing the model name (cube or city)");
+  if (args.empty()) {
+    return UsageError("missing the model name (cube, city or landmarks)");
+  }
+  if (args[0] == "landmarks") return RunGenerateLandmarks(args);
   const std::string& model = args[0];
   if (model != "cube" && model != "city") {
-    return UsageError("unknown model '" + model + "' (cube or city)");
+    return UsageError("unknown model '" + model + "' (cube, city or landmarks)");
   }
   if (args.size() > 1) {
     return UsageError("unexpected argument '" + args[1] + "'");

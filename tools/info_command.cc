@@ -1,6 +1,7 @@
 // `ceres_sesync info GRAPH.g2o [--json PATH] [--skip_unsupported_tags]`:
 // reads a pose graph and describes it (dimension, sizes, connectivity, the
-// range of the precisions kappa and tau, initial guess, FIX, skipped lines).
+// range of the precisions kappa and tau, landmarks and their measurements'
+// precisions nu, priors by kind, initial guess, FIX, skipped lines).
 
 #include <algorithm>
 #include <chrono>
@@ -14,8 +15,9 @@
 #include "tools/commands.h"
 
 DEFINE_bool(skip_unsupported_tags, false,
-            "Skip (and count) g2o lines with tags SE-Sync cannot use, such as "
-            "landmarks and priors, instead of rejecting the file.");
+            "Skip (and count) g2o lines with tags ceres_sesync does not "
+            "support (e.g. bearing-only or projection edges) instead of "
+            "rejecting the file.");
 
 namespace ceres_sesync::tools {
 namespace {
@@ -76,6 +78,20 @@ int RunInfo(const Args& args) {
   }
   const Range kappa = RangeOf(kappas);
   const Range tau = RangeOf(taus);
+  std::vector<double> nus;
+  for (const auto& m : graph.landmark_measurements) nus.push_back(m.nu);
+  const Range nu = RangeOf(nus);
+  int position_priors = 0, rotation_priors = 0, pose_priors = 0;
+  for (const auto& p : graph.priors) {
+    if (p.has_position() && p.has_rotation()) {
+      ++pose_priors;
+    } else if (p.has_position()) {
+      ++position_priors;
+    } else {
+      ++rotation_priors;
+    }
+  }
+  const bool has_initial_landmarks = !graph.initial_landmarks.empty();
   const int num_components = ConnectedComponents(graph, nullptr);
   const bool has_initial_guess = !graph.initial_poses.empty();
 
@@ -88,8 +104,22 @@ int RunInfo(const Args& args) {
               kappa.median, kappa.max);
   std::printf("tau min / median / max:    %.6g / %.6g / %.6g\n", tau.min,
               tau.median, tau.max);
+  std::printf("landmarks:                 %d\n", graph.num_landmarks);
+  std::printf("landmark measurements:     %d\n", summary.num_landmark_edges);
+  if (!nus.empty()) {
+    std::printf("nu min / median / max:     %.6g / %.6g / %.6g\n", nu.min,
+                nu.median, nu.max);
+  }
+  std::printf(
+      "priors:                    %d (position %d, rotation %d, "
+      "pose %d)\n",
+      summary.num_priors, position_priors, rotation_priors, pose_priors);
   std::printf("initial guess:             %s\n",
               has_initial_guess ? "yes (VERTEX lines)" : "no");
+  if (graph.num_landmarks > 0) {
+    std::printf("landmark initial guess:    %s\n",
+                has_initial_landmarks ? "yes (VERTEX lines)" : "no");
+  }
   if (graph.fixed_pose >= 0) {
     std::printf("fixed vertex (FIX):        %lld\n",
                 static_cast<long long>(graph.vertex_ids[graph.fixed_pose]));
@@ -116,7 +146,21 @@ int RunInfo(const Args& args) {
     json.Int("num_components", num_components);
     AddRange("kappa", kappa, &json);
     AddRange("tau", tau, &json);
+    json.Int("num_landmarks", graph.num_landmarks);
+    json.Int("num_landmark_measurements", summary.num_landmark_edges);
+    if (!nus.empty()) {
+      AddRange("nu", nu, &json);
+    } else {
+      json.Null("nu");
+    }
+    json.Int("num_priors", summary.num_priors);
+    json.BeginObject("priors");
+    json.Int("position", position_priors);
+    json.Int("rotation", rotation_priors);
+    json.Int("pose", pose_priors);
+    json.EndObject();
     json.Bool("has_initial_guess", has_initial_guess);
+    json.Bool("has_initial_landmarks", has_initial_landmarks);
     json.Bool("has_fix", summary.has_fix);
     if (graph.fixed_pose >= 0) {
       json.Int("fixed_vertex_id", graph.vertex_ids[graph.fixed_pose]);

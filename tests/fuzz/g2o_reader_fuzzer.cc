@@ -5,9 +5,10 @@
 // with skip_unsupported_tags = false and = true. Besides "no crash, no
 // sanitizer report", the fuzzer checks what the reader promises (g2o_io.h):
 //
-//  - a successful read yields a graph that passes ValidatePoseGraph, whose
-//    bookkeeping (vertex_ids, index_of_vertex_id, initial_poses, fixed_pose)
-//    is consistent, and whose G2oReadSummary matches the graph;
+//  - a successful read yields a graph that passes ValidatePoseGraph (with
+//    landmarks and priors allowed), whose bookkeeping (vertex_ids,
+//    index_of_vertex_id, initial_poses, fixed_pose, and the same for the
+//    landmarks) is consistent, and whose G2oReadSummary matches the graph;
 //  - a failed read fills a non-empty message that starts with "NAME:";
 //  - reading is deterministic (a second read gives the same graph);
 //  - skipping unsupported tags only adds lines to skip: if the strict read
@@ -74,8 +75,25 @@ bool SameGraph(const PoseGraph& a, const PoseGraph& b) {
   if (a.dimension != b.dimension || a.num_poses != b.num_poses ||
       a.vertex_ids != b.vertex_ids || a.fixed_pose != b.fixed_pose ||
       a.measurements.size() != b.measurements.size() ||
-      a.initial_poses.size() != b.initial_poses.size()) {
+      a.initial_poses.size() != b.initial_poses.size() ||
+      a.landmark_ids != b.landmark_ids ||
+      a.initial_landmarks != b.initial_landmarks ||
+      a.landmark_measurements.size() != b.landmark_measurements.size() ||
+      a.priors.size() != b.priors.size()) {
     return false;
+  }
+  for (size_t k = 0; k < a.landmark_measurements.size(); ++k) {
+    const auto& p = a.landmark_measurements[k];
+    const auto& q = b.landmark_measurements[k];
+    if (p.i != q.i || p.l != q.l || p.z != q.z || p.nu != q.nu) return false;
+  }
+  for (size_t k = 0; k < a.priors.size(); ++k) {
+    const auto& p = a.priors[k];
+    const auto& q = b.priors[k];
+    if (p.i != q.i || p.R != q.R || p.t != q.t || p.kappa != q.kappa ||
+        p.tau != q.tau) {
+      return false;
+    }
   }
   for (size_t k = 0; k < a.measurements.size(); ++k) {
     const auto& p = a.measurements[k];
@@ -102,8 +120,29 @@ void CheckResult(const ReadResult& r) {
   }
   const PoseGraph& g = r.graph;
   std::string error;
-  FUZZ_CHECK(ceres_sesync::ValidatePoseGraph(g, &error), error);
-  FUZZ_CHECK(!g.measurements.empty(), "");
+  ceres_sesync::ValidationOptions validation;
+  validation.allow_landmarks_and_priors = true;
+  FUZZ_CHECK(ceres_sesync::ValidatePoseGraph(g, validation, &error), error);
+  FUZZ_CHECK(!g.measurements.empty() || !g.landmark_measurements.empty() ||
+                 !g.priors.empty(),
+             "");
+  FUZZ_CHECK(static_cast<int>(g.landmark_ids.size()) == g.num_landmarks, "");
+  FUZZ_CHECK(static_cast<int>(g.index_of_landmark_id.size()) == g.num_landmarks,
+             "");
+  for (int l = 0; l < g.num_landmarks; ++l) {
+    FUZZ_CHECK(g.landmark_ids[l] >= 0, "negative landmark id");
+    FUZZ_CHECK(g.FindLandmark(g.landmark_ids[l]) == l, "landmark map");
+    FUZZ_CHECK(g.FindVertex(g.landmark_ids[l]) < 0, "landmark id is a pose");
+  }
+  FUZZ_CHECK(
+      g.initial_landmarks.empty() ||
+          static_cast<int>(g.initial_landmarks.size()) == g.num_landmarks,
+      "");
+  FUZZ_CHECK(r.summary.num_landmarks == g.num_landmarks, "");
+  FUZZ_CHECK(r.summary.num_landmark_edges ==
+                 static_cast<int>(g.landmark_measurements.size()),
+             "");
+  FUZZ_CHECK(r.summary.num_priors == static_cast<int>(g.priors.size()), "");
   FUZZ_CHECK(static_cast<int>(g.vertex_ids.size()) == g.num_poses, "");
   FUZZ_CHECK(static_cast<int>(g.index_of_vertex_id.size()) == g.num_poses, "");
   for (int k = 0; k < g.num_poses; ++k) {

@@ -92,6 +92,63 @@ PoseGraph RandomPoseGraph(const RandomGraphOptions& options,
   return graph;
 }
 
+PoseGraph RandomLandmarkGraph(const RandomLandmarkGraphOptions& options,
+                              Solution* truth) {
+  Solution x;
+  PoseGraph graph = RandomPoseGraph(options.poses, &x.poses);
+  const int d = graph.dimension, n = graph.num_poses;
+  const bool noisy = !options.poses.noiseless;
+  std::mt19937_64 rng(options.poses.seed + 0x9e3779b97f4a7c15ULL);
+  std::uniform_real_distribution<double> uniform(
+      -options.poses.translation_scale, options.poses.translation_scale);
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  std::normal_distribution<double> normal;
+  auto noise = [&](double precision) {
+    Eigen::VectorXd v(d);
+    for (int a = 0; a < d; ++a) {
+      v(a) = noisy ? normal(rng) / std::sqrt(precision) : 0.0;
+    }
+    return v;
+  };
+  for (int l = 0; l < options.num_landmarks; ++l) {
+    graph.AddLandmark(n + l);
+    Eigen::VectorXd p(d);
+    for (int a = 0; a < d; ++a) p(a) = uniform(rng);
+    x.landmarks.push_back(p);
+    for (int k = 0; k < options.observations_per_landmark; ++k) {
+      LandmarkMeasurement m;
+      m.i = pick(rng);
+      m.l = l;
+      m.z =
+          x.poses[m.i].R.transpose() * (p - x.poses[m.i].t) + noise(options.nu);
+      m.nu = options.nu;
+      graph.landmark_measurements.push_back(m);
+    }
+  }
+  auto add_prior = [&](bool rotation, bool position) {
+    PosePrior prior;
+    prior.i = pick(rng);
+    const Pose& pose = x.poses[prior.i];
+    if (rotation) {
+      prior.kappa = options.prior_kappa;
+      prior.R = pose.R;
+      if (noisy) {
+        prior.R = prior.R * SampleIsotropicLangevin(d, prior.kappa, &rng);
+      }
+    }
+    if (position) {
+      prior.tau = options.prior_tau;
+      prior.t = pose.t + noise(prior.tau);
+    }
+    graph.priors.push_back(prior);
+  };
+  for (int k = 0; k < options.num_position_priors; ++k) add_prior(false, true);
+  for (int k = 0; k < options.num_rotation_priors; ++k) add_prior(true, false);
+  for (int k = 0; k < options.num_pose_priors; ++k) add_prior(true, true);
+  if (truth) *truth = std::move(x);
+  return graph;
+}
+
 void MakeMeasurementsExact(const Poses& truth, PoseGraph* graph) {
   for (RelativePoseMeasurement& e : graph->measurements) {
     e = ExactMeasurement(truth, e.i, e.j, e.kappa, e.tau);
@@ -157,6 +214,62 @@ Eigen::MatrixXd DenseDataMatrix(const PoseGraph& graph) {
     M += m.tau * e * e.transpose();
   }
   return M;
+}
+
+Eigen::MatrixXd DenseLandmarkDataMatrix(const PoseGraph& graph) {
+  const int d = graph.dimension, n = graph.num_poses, L = graph.num_landmarks;
+  const int tw = n + L;                              // Column of t_w.
+  auto rot = [&](int i) { return tw + 1 + d * i; };  // R_i; R_w = rot(n).
+  const int size = tw + 1 + d * (n + 1);
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(d, d);
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(size, size);
+  for (const RelativePoseMeasurement& m : graph.measurements) {
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(size, d);
+    E.middleRows(rot(m.j), d) += I;
+    E.middleRows(rot(m.i), d) -= m.R;
+    M += m.kappa * E * E.transpose();
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
+    e(m.j) += 1;
+    e(m.i) -= 1;
+    e.segment(rot(m.i), d) -= m.t;
+    M += m.tau * e * e.transpose();
+  }
+  for (const LandmarkMeasurement& m : graph.landmark_measurements) {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
+    e(n + m.l) += 1;
+    e(m.i) -= 1;
+    e.segment(rot(m.i), d) -= m.z;
+    M += m.nu * e * e.transpose();
+  }
+  for (const PosePrior& p : graph.priors) {
+    if (p.kappa > 0) {
+      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(size, d);
+      E.middleRows(rot(p.i), d) += I;
+      E.middleRows(rot(n), d) -= p.R;
+      M += p.kappa * E * E.transpose();
+    }
+    if (p.tau > 0) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
+      e(p.i) += 1;
+      e(tw) -= 1;
+      e.segment(rot(n), d) -= p.t;
+      M += p.tau * e * e.transpose();
+    }
+  }
+  return M;
+}
+
+Eigen::MatrixXd StackLandmarkSolution(const PoseGraph& graph,
+                                      const Solution& solution) {
+  const int d = graph.dimension, n = graph.num_poses, L = graph.num_landmarks;
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(d, n + L + 1 + d * (n + 1));
+  for (int i = 0; i < n; ++i) {
+    X.col(i) = solution.poses[i].t;
+    X.middleCols(n + L + 1 + d * i, d) = solution.poses[i].R;
+  }
+  for (int l = 0; l < L; ++l) X.col(n + l) = solution.landmarks[l];
+  X.rightCols(d) = Eigen::MatrixXd::Identity(d, d);  // R_w; t_w = 0.
+  return X;
 }
 
 Eigen::MatrixXd DenseQ(const PoseGraph& graph) {

@@ -47,6 +47,32 @@ struct RandomGraphOptions {
 PoseGraph RandomPoseGraph(const RandomGraphOptions& options,
                           Poses* ground_truth);
 
+struct RandomLandmarkGraphOptions {
+  // The pose graph (RandomPoseGraph with these options; its seed is used
+  // for everything).
+  RandomGraphOptions poses;
+  // Number of landmarks, uniform in [-scale, scale]^d (scale:
+  // poses.translation_scale), each observed by `observations_per_landmark`
+  // poses drawn uniformly (with repetition) with precision nu.
+  int num_landmarks = 8;
+  int observations_per_landmark = 2;
+  double nu = 50;
+  // Priors on random poses: position-only (precision prior_tau), rotation-
+  // only (prior_kappa) and full pose priors (both).
+  int num_position_priors = 0;
+  int num_rotation_priors = 0;
+  int num_pose_priors = 0;
+  double prior_kappa = 200;
+  double prior_tau = 100;
+};
+
+// RandomPoseGraph plus landmarks and priors with noise from the same model
+// (exact if options.poses.noiseless): z = R_i^T (p_l - t_i) + N(0, I / nu),
+// g = t_i + N(0, I / prior_tau), R~ = R_i Langevin(prior_kappa). Landmark
+// ids continue after the pose ids (n, n + 1, ...). `truth` may be null.
+PoseGraph RandomLandmarkGraph(const RandomLandmarkGraphOptions& options,
+                              Solution* truth);
+
 // A Haar-uniform random rotation in SO(d).
 Eigen::MatrixXd RandomRotation(int d, std::mt19937_64* rng);
 
@@ -75,6 +101,22 @@ double GaugeInvariantPoseDistance(const Poses& a, const Poses& b);
 // M = sum kappa E E^T + tau e e^T, where X E = R_j - R_i R~ and X e = t_j - t_i
 // - R_i t~. Columns 0..n-1 are translations, then rotation blocks.
 Eigen::MatrixXd DenseDataMatrix(const PoseGraph& graph);
+
+// The dense data matrix of the objective with landmarks and priors
+// (pose_graph.h), from the residuals: with the world pose w = (I, 0)
+// appended as a pose and
+//   X = [t_1 .. t_n, p_1 .. p_L, t_w | R_1 .. R_n, R_w]
+// (d x (n + L + 1 + d (n + 1))), F(x, p) = tr(X M X^T) at t_w = 0, R_w = I.
+// Every term is ||X e||^2 or ||X E||_F^2 for a fixed e / E: an edge as in
+// DenseDataMatrix, a landmark measurement X e = p_l - t_i - R_i z, a
+// rotation prior X E = R_i - R_w R~, a position prior X e = t_i - t_w -
+// R_w g. Columns: translations 0..n-1, landmarks n..n+L-1, t_w at n+L, then
+// the rotation blocks (pose i at n+L+1+d i, R_w last).
+Eigen::MatrixXd DenseLandmarkDataMatrix(const PoseGraph& graph);
+
+// X = [T P t_w | R R_w] of DenseLandmarkDataMatrix for a solution.
+Eigen::MatrixXd StackLandmarkSolution(const PoseGraph& graph,
+                                      const Solution& solution);
 
 // Dense Q (dn x dn): the Schur complement of the translation block of M,
 // Q = M_RR - M_RT pinv(M_TT) M_TR (pinv: the Laplacian M_TT of a connected
