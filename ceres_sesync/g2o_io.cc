@@ -474,7 +474,7 @@ bool ParseG2oText(std::string_view text, const std::string& name,
 
   std::vector<int> component;
   const int num_components = ConnectedComponents(*graph, &component);
-  if (num_components > 1) {
+  if (num_components > 1 && !options.allow_disconnected) {
     std::vector<int> sizes(num_components, 0);
     for (int c : component) ++sizes[c];
     // The first pose outside the component of pose 0.
@@ -497,7 +497,7 @@ bool ParseG2oText(std::string_view text, const std::string& name,
   }
 
   std::string invalid;
-  if (!ValidatePoseGraph(*graph, &invalid)) {
+  if (!ValidatePoseGraph(*graph, &invalid, !options.allow_disconnected)) {
     if (error) *error = name + ": invalid pose graph: " + invalid;
     return false;
   }

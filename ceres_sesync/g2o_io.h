@@ -32,8 +32,9 @@
 // self-loops, unsupported tags (unless skipped by option; the legacy 3D TORO
 // tags VERTEX3/EDGE3 are always rejected), edges to vertices without a VERTEX
 // line when the file has VERTEX lines, duplicate VERTEX ids, files without
-// edges, and disconnected measurement graphs. The result always passes
-// ValidatePoseGraph().
+// edges, and disconnected measurement graphs (unless allowed by option). The
+// result always passes ValidatePoseGraph() (without the connectivity check
+// when G2oReadOptions::allow_disconnected is set).
 //
 // Every writer replaces its output file atomically (temporary file + rename):
 // on failure no partial file is left behind.
@@ -56,6 +57,11 @@ struct G2oReadOptions {
   // with a glog warning. The legacy 3D TORO tags VERTEX3/EDGE3 are rejected
   // either way.
   bool skip_unsupported_tags = false;
+  // A disconnected measurement graph (including VERTEX lines without edges)
+  // is an error by default. If true it is accepted; the result then passes
+  // ValidatePoseGraph(graph, error, /*require_connected=*/false) and can be
+  // solved per connected component (component_solver.h).
+  bool allow_disconnected = false;
 };
 
 struct G2oReadSummary {

@@ -56,7 +56,8 @@ int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component) {
   return k;
 }
 
-bool ValidatePoseGraph(const PoseGraph& graph, std::string* error) {
+bool ValidatePoseGraph(const PoseGraph& graph, std::string* error,
+                       bool require_connected) {
   auto fail = [&](const std::string& message) {
     if (error) *error = message;
     return false;
@@ -102,6 +103,7 @@ bool ValidatePoseGraph(const PoseGraph& graph, std::string* error) {
       }
     }
   }
+  if (!require_connected) return true;
   const int k = ConnectedComponents(graph, nullptr);
   if (k != 1) {
     std::ostringstream s;

@@ -71,8 +71,11 @@ int ConnectedComponents(const PoseGraph& graph, std::vector<int>* component);
 // d in {2, 3}; indices in range; no self-loops; finite, positive kappa and
 // tau; rotations in SO(d) to 1e-6; a connected measurement graph; initial
 // poses (if any) of the right size; fixed_pose -1 or a pose index. Returns
-// false with a message otherwise.
-bool ValidatePoseGraph(const PoseGraph& graph, std::string* error);
+// false with a message otherwise. With require_connected = false a
+// disconnected graph passes (each component is then a pose graph of its own;
+// see component_solver.h).
+bool ValidatePoseGraph(const PoseGraph& graph, std::string* error,
+                       bool require_connected = true);
 
 // Evaluates the maximum-likelihood objective F(x) of eq. (12).
 double EvaluateObjective(const PoseGraph& graph, const Poses& poses);

@@ -96,6 +96,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     return;
   }
 
+  Progress("data");
   const auto t = Clock::now();
   problem_ = std::make_unique<SESyncProblem>(
       graph, ResolveNumThreads(options.num_threads));
@@ -128,6 +129,19 @@ double Staircase::Elapsed() const {
   return std::chrono::duration<double>(Clock::now() - start_).count();
 }
 
+void Staircase::Progress(const char* stage, int rank, int iteration,
+                         double objective, double gradient_norm) const {
+  if (!options_.progress) return;
+  SolverProgress p;
+  p.stage = stage;
+  p.rank = rank;
+  p.iteration = iteration;
+  p.objective = objective;
+  p.gradient_norm = gradient_norm;
+  p.elapsed_s = Elapsed();
+  options_.progress(p);
+}
+
 double Staircase::RemainingTime() const {
   return options_.max_time_s > 0
              ? std::max(1e-3, options_.max_time_s - Elapsed())
@@ -141,6 +155,7 @@ Poses Staircase::Trivial() const {
 
 bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
   SolverSummary& s = *summary_;
+  Progress("initialize");
   const auto t = Clock::now();
   const int d = d_, n = n_;
   Y->setZero(r0_, d * n);
@@ -184,6 +199,7 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
   // The gradient tolerance is relative to the final F, so repeat (cheaply,
   // from the current point) if F dropped below the guess.
   double f = cost.Evaluate(*Y);
+  Progress("optimize", rank, 0, f);
   const bool use_ceres =
       options_.local_solver == SolverOptions::LocalSolver::kCeresLbfgs;
   if (use_ceres) {
@@ -201,6 +217,7 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
       LOG(INFO) << "rank " << rank << " iter " << it << " F " << f << " |grad| "
                 << g << " radius " << radius << " tCG " << inner;
     }
+    Progress("optimize", rank, level->iterations + it, f, g);
     return !options_.callback || options_.callback(rank, it, f, g, radius);
   };
   for (int pass = 0; pass < 3 && !use_ceres; ++pass) {
@@ -283,6 +300,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
     sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
     level.sdp_value = sdp_value_;
 
+    Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
     t = Clock::now();
     verification_ = Verify(sdp_value_);
     level.verify_time_s =
@@ -331,6 +349,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
 
 Poses Staircase::Round(const Eigen::MatrixXd& Y) {
   SolverSummary& s = *summary_;
+  Progress("round", static_cast<int>(Y.rows()));
   const auto t = Clock::now();
   Eigen::MatrixXd R = RoundSolution(Y, d_);
   if (options_.refine_rounded_solution) {
@@ -387,6 +406,7 @@ void Staircase::Report(const Poses& poses) {
     s.status = SolverSummary::Status::kRelaxationNotExact;
   }
   s.total_time_s = Elapsed();
+  Progress("done", s.final_rank, s.iterations, s.objective);
 }
 
 }  // namespace ceres_sesync::internal
