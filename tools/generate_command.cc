@@ -10,28 +10,27 @@
 #include "gflags/gflags.h"
 #include "tools/commands.h"
 
-DEFINE_int32(side, 10, "generate: side length s of the lattice, in poses.");
-DEFINE_int32(dimension, 3,
-             "generate: 3 for the s x s x s cube, 2 for the s x s grid.");
+DEFINE_int32(side, 10, "Side length s of the lattice, in poses.");
+DEFINE_int32(dimension, 3, "3 for the s x s x s cube, 2 for the s x s grid.");
 DEFINE_double(loop_closure_probability, 0.1,
-              "generate: probability pLC of a loop closure between each pair "
+              "Probability pLC of a loop closure between each pair "
               "of nearby non-sequential poses.");
 DEFINE_double(loop_closure_radius, 1.0,
-              "generate: loop-closure candidates are non-consecutive poses "
+              "Loop-closure candidates are non-consecutive poses "
               "at most this many lattice units apart, in [1, 4] (1: lattice "
               "neighbours; sqrt(3): the 3 x 3 x 3 block).");
 DEFINE_double(kappa, 16.67,
-              "generate: rotational concentration of every measurement "
+              "Rotational concentration of every measurement "
               "(16.67 ~ 10 deg RMS).");
 DEFINE_double(tau, 75,
-              "generate: translational precision of every measurement (75 ~ "
+              "Translational precision of every measurement (75 ~ "
               "0.2 m RMS in 3D).");
-DEFINE_uint64(seed, 0, "generate: random seed (deterministic output).");
+DEFINE_uint64(seed, 0, "Random seed (deterministic output).");
 DEFINE_string(ground_truth, "",
-              "generate: also write the ground-truth poses (VERTEX lines) to "
+              "Also write the ground-truth poses (VERTEX lines) to "
               "this g2o file.");
 DEFINE_string(vertices, "odometry",
-              "generate: VERTEX lines of --output: 'odometry' (dead reckoning "
+              "VERTEX lines of --output: 'odometry' (dead reckoning "
               "along the path, like recorded datasets), 'ground_truth', or "
               "'none'.");
 
