@@ -47,7 +47,9 @@ class CMakeBuild(build_ext):
             configure.append(f"-DCERES_SESYNC_BUILD_{part}=OFF")
         subprocess.run(configure, check=True)
         jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL", "2")
-        subprocess.run(["cmake", "--build", str(build), "--target", "_ceres_sesync", "-j", jobs], check=True)
+        subprocess.run(
+            ["cmake", "--build", str(build), "--target", "_ceres_sesync", "-j", jobs], check=True
+        )
         built = list((build / "python" / "ceres_sesync").glob("_ceres_sesync*.so"))
         if len(built) != 1:
             raise RuntimeError(f"expected one extension module in {build}, found {built}")
@@ -59,7 +61,7 @@ class CMakeBuild(build_ext):
 setup(
     name="ceres_sesync",
     version=version(),
-    description="SE-Sync certifiably correct pose-graph optimization for Ceres users, on numpy arrays",
+    description="SE-Sync certifiable pose-graph optimization for Ceres users, on numpy arrays",
     packages=["ceres_sesync"],
     package_dir={"ceres_sesync": "python/ceres_sesync"},
     ext_modules=[Extension("ceres_sesync._ceres_sesync", sources=[])],

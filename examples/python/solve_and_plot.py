@@ -38,7 +38,9 @@ def objective(graph, R, t):
     m = graph.measurements
     rotation = R[m.j] - R[m.i] @ m.R
     translation = t[m.j] - t[m.i] - np.einsum("kab,kb->ka", R[m.i], m.t)
-    return np.sum(m.kappa * np.sum(rotation**2, axis=(1, 2))) + np.sum(m.tau * np.sum(translation**2, axis=1))
+    return np.sum(m.kappa * np.sum(rotation**2, axis=(1, 2))) + np.sum(
+        m.tau * np.sum(translation**2, axis=1)
+    )
 
 
 def plot(graph, t, title, path):
@@ -65,7 +67,9 @@ def plot(graph, t, title, path):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("graph", nargs="?", help="g2o file (default: intel.g2o or a generated cube)")
+    parser.add_argument(
+        "graph", nargs="?", help="g2o file (default: intel.g2o or a generated cube)"
+    )
     parser.add_argument("--output", default="solve_and_plot.png", help="PNG file to write")
     args = parser.parse_args()
 

@@ -103,7 +103,8 @@ def read_g2o(path, *, return_summary=False, **options):
     what is wrong") for bad contents (see ceres_sesync/g2o_io.h).
     """
     path = _input_path(path)
-    graph, summary = _core._read_g2o(path, _options(G2oReadOptions, options, "read_g2o"))
+    options = _options(G2oReadOptions, options, "read_g2o")
+    graph, summary = _core._read_g2o(path, options)
     return (graph, summary) if return_summary else graph
 
 
@@ -231,7 +232,8 @@ def solve(graph, initial_rotations=None, **options):
     lower_bound, relative_suboptimality_bound, levels, times, ...), certified,
     rotations (n, d, d), translations (n, d), and summary (the full report).
     """
-    return _core._solve(graph, _options(SolverOptions, options, "solve"), initial_rotations)
+    options = _options(SolverOptions, options, "solve")
+    return _core._solve(graph, options, initial_rotations)
 
 
 def solve_components(graph, **options):
@@ -243,7 +245,8 @@ def solve_components(graph, **options):
     objective / lower_bound / ..., status, certified, and rotations and
     translations of the whole graph.
     """
-    return _core._solve_by_component(graph, _options(SolverOptions, options, "solve_components"))
+    options = _options(SolverOptions, options, "solve_components")
+    return _core._solve_by_component(graph, options)
 
 
 def certify(graph, rotations, translations, **options):
@@ -259,7 +262,8 @@ def certify(graph, rotations, translations, **options):
 
     Raises ValueError for arrays of the wrong shape or non-finite values.
     """
-    return _core._certify(graph, rotations, translations, _options(CertifyOptions, options, "certify"))
+    options = _options(CertifyOptions, options, "certify")
+    return _core._certify(graph, rotations, translations, options)
 
 
 # ---- generic helpers on every bound struct -------------------------------------

@@ -77,7 +77,8 @@ def test_errors():
         cs.certify(g, bad, t)
     with pytest.raises(TypeError, match="must be an array"):
         cs.certify(g, None, t)
-    with pytest.raises(TypeError, match=r"^certify\(\) got an unexpected keyword argument 'solver_options.robust'$"):
+    unexpected = r"^certify\(\) got an unexpected keyword argument 'solver_options.robust'$"
+    with pytest.raises(TypeError, match=unexpected):
         cs.certify(g, R, t, solver_options={"robust": True})
     with pytest.raises(TypeError, match="unexpected keyword argument 'tolerance'"):
         cs.certify(g, R, t, tolerance=1)
@@ -98,6 +99,7 @@ def test_equal_to_the_cpp_api(tmp_path):
     assert run.returncode == 0, run.stdout + run.stderr
     cpp = json.loads((tmp_path / "c.json").read_text())
     c = cs.certify(g, R, t)
-    for key in ["objective", "rotation_objective", "eta", "lower_bound", "relative_suboptimality_bound"]:
+    keys = ["objective", "rotation_objective", "eta", "lower_bound", "relative_suboptimality_bound"]
+    for key in keys:
         assert getattr(c, key) == cpp[key], key
     assert c.certified == cpp["certified"] is True

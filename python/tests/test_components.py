@@ -47,15 +47,19 @@ def test_each_component_is_solved_as_its_own_graph(d):
         np.testing.assert_array_equal(r.translations[offset : offset + n], alone.translations)
         np.testing.assert_allclose(r.rotations[offset], np.eye(d), atol=1e-12)  # own gauge
         offset += n
-    assert r.objective == pytest.approx(sum(c.summary.objective for c in r.components), rel=1e-15)
-    assert r.lower_bound == pytest.approx(sum(c.summary.lower_bound for c in r.components), rel=1e-15)
-    assert r.objective == pytest.approx(cs.evaluate_objective(g, r.rotations, r.translations), rel=1e-12)
+    total = sum(c.summary.objective for c in r.components)
+    assert r.objective == pytest.approx(total, rel=1e-15)
+    bound = sum(c.summary.lower_bound for c in r.components)
+    assert r.lower_bound == pytest.approx(bound, rel=1e-15)
+    f = cs.evaluate_objective(g, r.rotations, r.translations)
+    assert r.objective == pytest.approx(f, rel=1e-12)
     assert "Connected components" in r.summary
     split = g.split_into_components()
     assert [len(c.poses) for c in split] == [p.num_poses for p in parts]
     for part, c in zip(parts, split):
         np.testing.assert_array_equal(c.graph.measurements.R, part.measurements.R)
-        np.testing.assert_array_equal(g.measurements.i[c.measurements], c.poses[c.graph.measurements.i])
+        global_i = g.measurements.i[c.measurements]
+        np.testing.assert_array_equal(global_i, c.poses[c.graph.measurements.i])
     assert r.as_dict()["components"][1]["summary"]["status"] == "CERTIFIED_OPTIMUM"
 
 

@@ -80,7 +80,8 @@ def test_bad_arrays_raise_value_errors_that_name_the_problem():
             make(*args.values(), **options)
         return str(info.value)
 
-    assert "R must have shape (%d, 3, 3), not (%d, 2, 2)" % (len(i), len(i)) in error(R=Rm[:, :2, :2])
+    m = len(i)
+    assert f"R must have shape ({m}, 3, 3), not ({m}, 2, 2)" in error(R=Rm[:, :2, :2])
     assert "t must have shape" in error(t=tm[:-1])
     assert "kappa must have shape" in error(kappa=k[:, None])
     assert "j must have shape" in error(j=j[:-1])

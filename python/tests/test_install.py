@@ -11,7 +11,9 @@ CMAKE = os.environ.get("CERES_SESYNC_CMAKE", "cmake")
 INSTALL_DIR = os.environ.get("CERES_SESYNC_PYTHON_INSTALL_DIR", "")
 PREFIX = os.environ.get("CERES_SESYNC_INSTALL_PREFIX", "")
 
-pytestmark = pytest.mark.skipif(not BINARY_DIR or not INSTALL_DIR, reason="run by ctest (needs the build directory)")
+pytestmark = pytest.mark.skipif(
+    not BINARY_DIR or not INSTALL_DIR, reason="run by ctest (needs the build directory)"
+)
 
 SCRIPT = """
 import ceres_sesync as cs
@@ -36,7 +38,9 @@ def test_installed_package_imports_and_solves(tmp_path):
     assert any(f.startswith("_ceres_sesync.") and f.endswith(".so") for f in files), files
     # Import from the install only (not from the build tree), from elsewhere.
     env = dict(os.environ, PYTHONPATH=str(prefix / INSTALL_DIR))
-    run = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, cwd=tmp_path)
+    run = subprocess.run(
+        [sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, cwd=tmp_path
+    )
     assert run.returncode == 0, run.stdout + run.stderr
     file, status = run.stdout.split()
     assert file == str(package / "__init__.py")
@@ -47,5 +51,6 @@ def test_default_install_dir_is_on_the_interpreters_path():
     if PREFIX not in ("/usr/local", "/usr"):
         pytest.skip(f"install prefix {PREFIX} is not a system prefix")
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-    run = subprocess.run([sys.executable, "-c", "import sys; print('\\n'.join(sys.path))"], capture_output=True, text=True, env=env)
+    script = "import sys; print('\\n'.join(sys.path))"
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env)
     assert os.path.join(PREFIX, INSTALL_DIR) in run.stdout.split("\n"), run.stdout

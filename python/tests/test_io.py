@@ -49,7 +49,8 @@ def test_read_a_small_file(tmp_path):
 
 
 def test_bad_input_names_file_and_line(tmp_path):
-    path = write(tmp_path / "bad.g2o", "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n\nEDGE_SE2 1 2 1 0 0 1 0 0 1 0 oops\n")
+    text = "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n\nEDGE_SE2 1 2 1 0 0 1 0 0 1 0 oops\n"
+    path = write(tmp_path / "bad.g2o", text)
     with pytest.raises(ValueError, match=f"^{path}:3: "):
         cs.read_g2o(path)
     path = write(tmp_path / "nan.g2o", "EDGE_SE2 0 1 nan 0 0 1 0 0 1 0 1\n")
@@ -70,7 +71,8 @@ def test_bad_input_names_file_and_line(tmp_path):
 
 
 def test_disconnected_file_only_when_allowed(tmp_path):
-    path = write(tmp_path / "two.g2o", "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nEDGE_SE2 5 6 1 0 0 1 0 0 1 0 1\n")
+    text = "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nEDGE_SE2 5 6 1 0 0 1 0 0 1 0 1\n"
+    path = write(tmp_path / "two.g2o", text)
     with pytest.raises(ValueError, match=f"^{path}:2: measurement graph is disconnected"):
         cs.read_g2o(path)
     g = cs.read_g2o(path, allow_disconnected=True)

@@ -2,7 +2,6 @@
 options by keyword, progress and stop callbacks, the GIL released."""
 
 import json
-import os
 import signal
 import threading
 import time
@@ -79,7 +78,8 @@ def test_option_errors():
         cs.solve(g, robust=True)
     with pytest.raises(TypeError, match="max_rank must be int, not str"):
         cs.solve(g, max_rank="10")
-    with pytest.raises(ValueError, match="initialization must be one of 'chordal', 'random', 'vertices', not 'chordial'"):
+    choices = "initialization must be one of 'chordal', 'random', 'vertices', not 'chordial'"
+    with pytest.raises(ValueError, match=choices):
         cs.solve(g, initialization="chordial")
     with pytest.raises(TypeError, match="progress must be a callable or None, not int"):
         cs.solve(g, progress=3)
