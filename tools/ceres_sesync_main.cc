@@ -289,6 +289,7 @@ bool FlagIsSet(const char* name) {
 
 int main(int argc, char** argv) {
   gflags::SetUsageMessage(GeneralHelp());
+  gflags::SetVersionString(CERES_SESYNC_VERSION);
   if (!CheckFlagNames(argc, argv)) return kUsageOrInputError;
   gflags::ParseCommandLineNonHelpFlags(&argc, &argv, /*remove_flags=*/true);
   const std::string name = argc >= 2 ? argv[1] : "";
