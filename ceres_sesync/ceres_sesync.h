@@ -25,8 +25,10 @@
 //                             odometry initialization.
 //   chordal_initialization.h  The chordal rotation initialization.
 //   cube_generator.h          The synthetic cube benchmark of the paper.
+//   city_generator.h          Large synthetic maps: a Manhattan-style walk
+//                             with loop closures on revisits.
 //   langevin.h                The isotropic Langevin / von Mises noise
-//                             samplers used by the generator.
+//                             samplers used by the generators.
 //   stiefel_manifold.h        St(d, r) and St(d, r)^n: free functions and
 //                             ceres::Manifold classes.
 //   riemannian_trust_region.h The Riemannian trust-region solver used by
@@ -41,6 +43,7 @@
 #include "ceres_sesync/ceres_baseline.h"
 #include "ceres_sesync/certification.h"
 #include "ceres_sesync/chordal_initialization.h"
+#include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/component_solver.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"

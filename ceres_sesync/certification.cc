@@ -30,7 +30,6 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
                 " poses, the graph has " + std::to_string(n));
   }
   Certificate c;
-  c.strict_round_off = options.strict_round_off;
   Poses projected = candidate;
   Eigen::MatrixXd R(d, d * n);
   for (int i = 0; i < n; ++i) {
@@ -66,21 +65,41 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
     const Eigen::MatrixXd Lambda = SymBlockDiagProduct(RQ, R, d);
     const double trace = internal::BlockDiagonalTrace(Lambda, d);
     c.rotation_objective = trace;
-    // Largest eta for which the bound can still meet the tolerance:
-    // objective - (trace - eta d n) <= tol (trace - eta d n).
-    const double tol = options.max_relative_suboptimality;
-    const double eta_max =
-        (tol * trace - (c.objective - trace)) / (d * n * (1 + tol));
-    const double eta_target =
+    // Largest eta for which the bound can still meet a relative bound b:
+    // objective - (trace - eta d n) <= b (trace - eta d n).
+    auto eta_for = [&](double b) {
+      return (b * trace - (c.objective - trace)) / (d * n * (1 + b));
+    };
+    internal::VerificationOptions verification;
+    verification.eta_max =
+        std::max(eta_for(options.max_relative_suboptimality), 0.0);
+    verification.eta_goal = eta_for(options.goal_relative_suboptimality);
+    verification.eta_target =
         std::max(options.target_relative_bound * std::abs(trace) / (d * n),
                  std::numeric_limits<double>::min());
-    internal::CertificateMatrix matrix(problem, options.strict_round_off);
-    const internal::VerificationResult v = internal::VerifyCertificate(
-        problem, Lambda, eta_target, std::max(eta_max, 0.0), &matrix);
+    switch (options.proof_arithmetic) {
+      case SolverOptions::ProofArithmetic::kAutomatic:
+        verification.policy = internal::ProofPolicy::kAutomatic;
+        break;
+      case SolverOptions::ProofArithmetic::kDouble:
+        verification.policy = internal::ProofPolicy::kDouble;
+        break;
+      case SolverOptions::ProofArithmetic::kDoubleDouble:
+        verification.policy = internal::ProofPolicy::kDoubleDouble;
+        break;
+    }
+    internal::CertificateMatrix matrix(problem);
+    const internal::VerificationResult v =
+        internal::VerifyCertificate(problem, Lambda, verification, &matrix);
     c.eta = v.eta;
     c.lambda_min = v.lambda_min_estimate;
-    c.lower_bound = trace - v.eta * d * n;
-    c.certified = v.certified && eta_max > 0;
+    c.factorizations = v.factorizations;
+    c.extended_factorizations = v.extended_factorizations;
+    c.extended_proof_time_s = v.extended_time_s;
+    if (std::isfinite(v.eta)) {
+      c.proof_precision = internal::ProofPrecisionName(v.precision);
+      c.lower_bound = internal::ProvenLowerBound(Lambda, d, v.eta);
+    }
     if (!v.certified && v.direction.size() == d * n &&
         v.direction_curvature < 0) {
       c.negative_curvature_direction = v.direction;
@@ -95,12 +114,15 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
   for (const RelativePoseMeasurement& e : graph.measurements) {
     total_weight += e.kappa + e.tau;
   }
-  if (c.objective <= 1e-12 * total_weight) c.certified = true;
+  const bool zero_objective = c.objective <= 1e-12 * total_weight;
   c.suboptimality_bound = c.objective - c.lower_bound;
   c.relative_suboptimality_bound =
       c.lower_bound > 0 ? c.suboptimality_bound / c.lower_bound
-      : c.certified     ? 0
+      : zero_objective  ? 0
                         : std::numeric_limits<double>::infinity();
+  // Certified iff the proven relative bound is within the tolerance.
+  c.certified = zero_objective || c.relative_suboptimality_bound <=
+                                      options.max_relative_suboptimality;
   c.time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
@@ -138,9 +160,11 @@ std::string Certificate::FullReport() const {
   } else {
     line("%-36s %.3e\n", "lambda_min(S) estimate", lambda_min);
   }
-  line("%-36s %.3e (%s)\n", "eta (S + eta I proven PSD)", eta,
-       strict_round_off ? "all round-off rigorous"
-                        : "translation-block round-off to first order");
+  line("%-36s %.3e (proof in %s, all round-off included)\n",
+       "eta (S + eta I proven PSD)", eta, proof_precision.c_str());
+  line("%-36s %d double, %d double-double (%.4f s)\n",
+       "Certificate factorizations", factorizations, extended_factorizations,
+       extended_proof_time_s);
   line("%-36s %.12g\n", "Lower bound on the optimum", lower_bound);
   line("%-36s %.3e\n", "Suboptimality bound", suboptimality_bound);
   line("%-36s %.3e\n", "Relative suboptimality bound",

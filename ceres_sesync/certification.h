@@ -28,19 +28,21 @@
 // never re-optimized silently). Certify answers "certified" when that bound,
 // relative to the lower bound, is at most `max_relative_suboptimality`.
 //
-// Floating point: a Cholesky factorization that completes proves K + E
-// positive definite for the computed factor's backward error E. eta includes
-// a rigorous worst-case bound on E (componentwise bound of Demmel 1989 and
-// Higham Thm. 10.3, any summation order, row by row, plus the rounding of the
-// assembly). One step is first order by default: the bound of K's
-// translation rows reaches S amplified by up to ||Lbar^{-1} Vbar||^2, which
-// is not added. With strict_round_off the factorized matrix has its
-// translation block lowered by at least that bound (Lbar - mu I), so the
-// proof carries over exactly to S + eta I; on large maps (poses far from
-// pose 0) that needs much larger shifts and may not certify at all (see the
-// README). Either way the proof is for the data matrices as computed from
-// the file (their own round-off, ~1e-16 relative per entry, is not
-// propagated).
+// What is proven, round-off included: the candidate's F (with its rotations
+// projected to SO(d)) minus a lower bound on the optimum of the problem
+// defined by the graph's measurements as doubles. The shift eta is proven
+// by a Cholesky factorization of K_eta with its translation block lowered
+// (CertificateMatrix::Prove): the rounding of the data matrices, of the
+// assembly and the factorization's backward error (Higham, Thm. 10.3, any
+// summation order) are bounded row by row; the translation rows' bound is
+// absorbed by the lowering and the rotation rows' bound is added to eta, so
+// S + eta I >= 0 follows with no first-order step. The lower bound
+// tr(Lambda) - eta d n is summed in double-double and rounded down. Double
+// precision resolves the certificate to about 1e-16 of the data's scale,
+// amplified on large maps by the squared extent of the map; when that is
+// above the goal (CertifyOptions::goal_relative_suboptimality), the proof is
+// redone in double-double arithmetic (internal/double_double.h: ~1e-31),
+// which certifies long trajectories and large maps to ~1e-7 and better.
 // Local minima from local search have lambda_min(S) many orders of magnitude
 // below these allowances, so they are never certified.
 
@@ -69,11 +71,15 @@ struct CertifyOptions {
   bool improve_if_not_certified = false;
   // Options for that improvement run.
   SolverOptions solver_options;
+  // A proof whose relative bound is above this is tightened in
+  // double-double arithmetic (proof_arithmetic kAutomatic); see
+  // SolverOptions::certification_goal_relative_bound.
+  double goal_relative_suboptimality = 1e-6;
+  SolverOptions::ProofArithmetic proof_arithmetic =
+      SolverOptions::ProofArithmetic::kAutomatic;
   // Threads for the products with Q (<= 0: all cores); see
   // SolverOptions::num_threads.
   int num_threads = 0;
-  // See SolverOptions::strict_round_off.
-  bool strict_round_off = false;
 };
 
 struct Certificate {
@@ -88,12 +94,17 @@ struct Certificate {
   // Estimate of lambda_min(S) (NaN if the first Cholesky test succeeded and
   // no eigensolve was needed).
   double lambda_min = 0;
-  // Shift for which S + eta I was proven positive semidefinite (including the
-  // factorization's backward-error allowance); +inf if none.
+  // Shift for which S + eta I was proven positive semidefinite (all
+  // round-off included); +inf if none.
   double eta = 0;
-  // eta accounts rigorously for all round-off (CertifyOptions::
-  // strict_round_off), not the translation block's to first order only.
-  bool strict_round_off = false;
+  // The arithmetic of the factorization that proved eta: "double",
+  // "double-double" or "none".
+  std::string proof_precision = "none";
+  // Certificate factorizations in double and in double-double, and the
+  // seconds the latter took (part of time_s).
+  int factorizations = 0;
+  int extended_factorizations = 0;
+  double extended_proof_time_s = 0;
   // Proven lower bound on the optimal value: max(0, tr(Lambda) - eta d n)
   // (F is a sum of squares). A candidate with F <= 1e-12 * sum(kappa + tau)
   // (e.g. a tree, or noiseless data) is certified by F >= 0 alone.

@@ -7,14 +7,12 @@
 #include <utility>
 #include <vector>
 
-#include "Eigen/Geometry"
+#include "ceres_sesync/internal/synthetic_graph.h"
 #include "ceres_sesync/langevin.h"
 
 namespace ceres_sesync {
 
 namespace {
-
-constexpr int64_t kMaxPoses = 10000000;
 
 using LatticePoint = std::array<int, 3>;
 
@@ -38,25 +36,6 @@ std::vector<LatticePoint> RectilinearPath(int d, int s) {
     }
   }
   return path;
-}
-
-// A rotation whose first column (the body's forward axis) is `forward`, a
-// lattice axis direction.
-Eigen::MatrixXd HeadingRotation(int d, const Eigen::Vector3d& forward) {
-  if (d == 2) {
-    Eigen::MatrixXd R(2, 2);
-    R << forward.x(), -forward.y(), forward.y(), forward.x();
-    return R;
-  }
-  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d left = std::abs(forward.z()) > 0.5
-                                   ? Eigen::Vector3d::UnitY().eval()
-                                   : up.cross(forward).eval();
-  Eigen::MatrixXd R(3, 3);
-  R.col(0) = forward;
-  R.col(1) = left;
-  R.col(2) = forward.cross(left);
-  return R;
 }
 
 // The lattice offsets of the loop-closure candidates of a pose: every
@@ -112,27 +91,21 @@ bool GenerateCube(const CubeOptions& options, PoseGraph* graph,
   int64_t n64 = 1;
   for (int k = 0; k < d; ++k) {
     n64 *= s;
-    if (n64 > kMaxPoses) {
+    if (n64 > internal::kMaxSyntheticPoses) {
       std::ostringstream m;
-      m << "cube side " << s << " gives more than " << kMaxPoses << " poses";
+      m << "cube side " << s << " gives more than "
+        << internal::kMaxSyntheticPoses << " poses";
       return fail(m.str());
     }
   }
   const double p_lc = options.loop_closure_probability;
-  if (!(p_lc >= 0 && p_lc <= 1)) {
-    return fail("loop closure probability must be in [0, 1]");
+  std::string noise_error;
+  if (!internal::CheckNoiseOptions(p_lc, options.kappa, options.tau,
+                                   options.spacing, &noise_error)) {
+    return fail(noise_error);
   }
   if (!(options.loop_closure_radius >= 1 && options.loop_closure_radius <= 4)) {
     return fail("loop closure radius must be in [1, 4] lattice units");
-  }
-  if (!(options.kappa > 0 && std::isfinite(options.kappa))) {
-    return fail("kappa must be finite and positive");
-  }
-  if (!(options.tau > 0 && std::isfinite(options.tau))) {
-    return fail("tau must be finite and positive");
-  }
-  if (!(options.spacing > 0 && std::isfinite(options.spacing))) {
-    return fail("spacing must be finite and positive");
   }
   const int n = static_cast<int>(n64);
 
@@ -149,7 +122,7 @@ bool GenerateCube(const CubeOptions& options, PoseGraph* graph,
     const int a = i + 1 < n ? i : i - 1;  // heading from a to a + 1
     Eigen::Vector3d forward;
     for (int k = 0; k < 3; ++k) forward[k] = path[a + 1][k] - path[a][k];
-    truth[i].R = HeadingRotation(d, forward);
+    truth[i].R = internal::HeadingRotation(d, forward);
     truth[i].t.resize(d);
     for (int k = 0; k < d; ++k) truth[i].t[k] = options.spacing * path[i][k];
   }
@@ -160,17 +133,8 @@ bool GenerateCube(const CubeOptions& options, PoseGraph* graph,
   for (int i = 0; i < n; ++i) g.AddVertex(i);
   std::mt19937_64 rng(options.seed);
   auto add_measurement = [&](int i, int j) {
-    RelativePoseMeasurement e;
-    e.i = i;
-    e.j = j;
-    e.kappa = options.kappa;
-    e.tau = options.tau;
-    e.R = truth[i].R.transpose() * truth[j].R *
-          SampleIsotropicLangevin(d, options.kappa, &rng);
-    e.t = truth[i].R.transpose() * (truth[j].t - truth[i].t);
-    const double sigma = 1 / std::sqrt(options.tau);
-    for (int k = 0; k < d; ++k) e.t[k] += sigma * SampleStandardNormal(&rng);
-    g.measurements.push_back(std::move(e));
+    internal::AddNoisyMeasurement(truth, i, j, options.kappa, options.tau, &rng,
+                                  &g);
   };
   // The offset set is symmetric, so each unordered pair is met twice; it is
   // drawn once, from its later pose.

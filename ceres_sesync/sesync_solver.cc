@@ -43,8 +43,8 @@ std::string SolverSummary::StatusString() const {
   switch (status) {
     case Status::kCertifiedOptimum:
       return "CERTIFIED_OPTIMUM";
-    case Status::kRelaxationNotExact:
-      return "RELAXATION_NOT_EXACT";
+    case Status::kBoundAboveTolerance:
+      return "BOUND_ABOVE_TOLERANCE";
     case Status::kSaddleNotEscaped:
       return "SADDLE_NOT_ESCAPED";
     case Status::kEigenImprecision:
@@ -68,10 +68,12 @@ std::string SolverSummary::BriefReport() const {
   }
   std::snprintf(buf, sizeof(buf),
                 "SE-Sync: %s, F(x) = %.10g, lower bound %.10g, relative "
-                "suboptimality <= %.2e, rank %d, %d iterations, %.3f s",
+                "suboptimality <= %.2e (proof in %s), rank %d%s, %d "
+                "iterations, %.3f s",
                 StatusString().c_str(), objective, lower_bound,
-                relative_suboptimality_bound, final_rank, iterations,
-                total_time_s);
+                relative_suboptimality_bound, proof_precision.c_str(),
+                final_rank, relaxation_exact ? "" : ", relaxation not exact",
+                iterations, total_time_s);
   return buf;
 }
 
@@ -91,12 +93,15 @@ std::string SolverSummary::FullReport() const {
     return out;
   }
   out += "\nRiemannian staircase\n";
-  line("  %4s %6s %8s %18s %11s %11s %11s %s\n", "rank", "iters", "Hv", "F(Y)",
-       "|grad F|", "eta", "lambda_min", "termination");
+  line("  %4s %6s %8s %18s %11s %11s %11s %7s %s\n", "rank", "iters", "Hv",
+       "F(Y)", "|grad F|", "eta", "lambda_min", "fact.", "termination");
   for (const Level& l : levels) {
-    line("  %4d %6d %8d %18.12g %11.3e %11.3e %11.3e %s%s\n", l.rank,
+    char factorizations[32];
+    std::snprintf(factorizations, sizeof(factorizations), "%d+%d",
+                  l.factorizations, l.extended_factorizations);
+    line("  %4d %6d %8d %18.12g %11.3e %11.3e %11.3e %7s %s%s\n", l.rank,
          l.iterations, l.hessian_vector_products, l.sdp_value, l.gradient_norm,
-         l.eta, l.lambda_min_estimate, l.termination.c_str(),
+         l.eta, l.lambda_min_estimate, factorizations, l.termination.c_str(),
          l.certified ? ", certified" : "");
   }
   out += "\nSolution\n";
@@ -107,9 +112,10 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %.3e\n", "Suboptimality bound", suboptimality_bound);
   line("%-34s %.3e\n", "Relative suboptimality bound",
        relative_suboptimality_bound);
-  line("%-34s %.3e (%s)\n", "eta (S + eta I proven PD)", eta,
-       strict_round_off ? "all round-off rigorous"
-                        : "translation-block round-off to first order");
+  line("%-34s %.3e (proof in %s, all round-off included)\n",
+       "eta (S + eta I proven PSD)", eta, proof_precision.c_str());
+  line("%-34s %s\n", "Relaxation exact",
+       relaxation_exact ? "yes" : "no (rounding gap or rank)");
   if (std::isnan(lambda_min_estimate)) {
     line("%-34s %s\n", "lambda_min(S) estimate",
          "not computed (Cholesky test sufficed)");
@@ -119,7 +125,9 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %d\n", "Final rank", final_rank);
   line("%-34s %d\n", "Trust-region iterations", iterations);
   line("%-34s %d\n", "Hessian-vector products", hessian_vector_products);
-  line("%-34s %d\n", "Certificate factorizations", factorizations);
+  line("%-34s %d double, %d double-double (%.4f s)\n",
+       "Certificate factorizations", factorizations, extended_factorizations,
+       extended_proof_time_s);
   out += "\nTime (seconds)\n";
   line("%-34s %.4f\n", "  Data matrices", data_time_s);
   line("%-34s %.4f\n", "  Initialization", initialization_time_s);
@@ -128,6 +136,7 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %.4f\n", "  Rounding", rounding_time_s);
   line("%-34s %.4f\n", "Total", total_time_s);
   line("\n%-34s %s\n", "Status", StatusString().c_str());
+  if (!message.empty()) line("%-34s %s\n", "", message.c_str());
   return out;
 }
 

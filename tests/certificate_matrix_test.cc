@@ -162,43 +162,59 @@ TEST_F(CertificateTest, MultiplyCertificateMatchesDense) {
   }
 }
 
-// Factorize(Lambda, c) succeeds iff lambda_min(S) > -c, for shifts whose
-// distance from -lambda_min(S) is far above round-off; and whenever it
-// succeeds, lambda_min(S) >= -proven_shift() (the documented guarantee).
-TEST_F(CertificateTest, FactorizeAgreesWithDenseEigenvalues) {
+// Factorize(Lambda, c) (no proof) succeeds iff lambda_min(S) > -c, for
+// shifts whose distance from -lambda_min(S) is far above round-off. Prove()
+// in either arithmetic never succeeds when S + cI is clearly indefinite, and
+// whenever it succeeds lambda_min(S) >= -proven_shift() (the documented
+// guarantee); double-double proofs succeed as soon as lambda_min(S + cI) is
+// above ~1e-25 ||S||, double proofs once it covers their round-off.
+TEST_F(CertificateTest, ProofsAgreeWithDenseEigenvalues) {
   for (const RandomGraphOptions& o : Graphs()) {
     instances_.clear();
     Build(o);
-    for (bool strict : {false, true}) {
-      CertificateMatrix matrix(*problem_, strict);
-      EXPECT_EQ(matrix.dimension(), o.dimension * o.num_poses);
-      for (const Instance& in : instances_) {
-        const double lmin = in.lambda_min, s = in.scale;
-        struct Shift {
-          double c;
-          bool must_succeed;
-        };
-        std::vector<Shift> shifts = {
-            {-lmin + 1e-3 * s, true},   // lambda_min(S + cI) = 1e-3 ||S||.
-            {-lmin - 1e-3 * s, false},  // lambda_min(S + cI) = -1e-3 ||S||.
-            {-lmin + 1e-6 * s, true},
-            {-lmin - 1e-6 * s, false}};
-        if (lmin < -1e-6 * s) {
-          // Straddle -lambda_min by a factor 2 both ways (brief's test); the
-          // "fail" case is lambda_min(S) = -2c: SOUNDNESS.
-          shifts.push_back({-2 * lmin, true});
-          shifts.push_back({-0.5 * lmin, false});
-          shifts.push_back({-1.1 * lmin, true});
-          shifts.push_back({-0.9 * lmin, false});
-        }
-        for (const Shift& sh : shifts) {
-          const bool ok = matrix.Factorize(in.Lambda, sh.c);
-          EXPECT_EQ(ok, sh.must_succeed)
-              << in.name << ": d " << o.dimension << " n " << o.num_poses
-              << " lambda_min(S) " << lmin << " c " << sh.c << " ||S|| " << s;
+    CertificateMatrix matrix(*problem_);
+    EXPECT_EQ(matrix.dimension(), o.dimension * o.num_poses);
+    for (const Instance& in : instances_) {
+      const double lmin = in.lambda_min, s = in.scale;
+      struct Shift {
+        double c;
+        bool positive_definite;
+      };
+      std::vector<Shift> shifts = {
+          {-lmin + 1e-3 * s, true},   // lambda_min(S + cI) = 1e-3 ||S||.
+          {-lmin - 1e-3 * s, false},  // lambda_min(S + cI) = -1e-3 ||S||.
+          {-lmin + 1e-6 * s, true},
+          {-lmin - 1e-6 * s, false}};
+      if (lmin < -1e-6 * s) {
+        // Straddle -lambda_min by a factor 2 both ways; the "fail" case is
+        // lambda_min(S) = -2c: SOUNDNESS.
+        shifts.push_back({-2 * lmin, true});
+        shifts.push_back({-0.5 * lmin, false});
+        shifts.push_back({-1.1 * lmin, true});
+        shifts.push_back({-0.9 * lmin, false});
+      }
+      for (const Shift& sh : shifts) {
+        SCOPED_TRACE(in.name + ": d " + std::to_string(o.dimension) + " n " +
+                     std::to_string(o.num_poses) + " lambda_min(S) " +
+                     std::to_string(lmin) + " c " + std::to_string(sh.c));
+        EXPECT_EQ(matrix.Factorize(in.Lambda, sh.c), sh.positive_definite);
+        for (auto precision : {internal::ProofPrecision::kDouble,
+                               internal::ProofPrecision::kDoubleDouble}) {
+          const bool ok = matrix.Prove(in.Lambda, sh.c, precision);
+          if (!sh.positive_definite) {
+            EXPECT_FALSE(ok);
+          }
+          if (precision == internal::ProofPrecision::kDoubleDouble ||
+              sh.c + lmin >= 1e-3 * s) {
+            EXPECT_EQ(ok, sh.positive_definite);
+          }
           if (ok) {
             EXPECT_GE(matrix.proven_shift(), sh.c);
-            EXPECT_GE(lmin, -matrix.proven_shift() - 1e-13 * s) << in.name;
+            EXPECT_GE(lmin, -matrix.proven_shift() - 1e-13 * s);
+            if (precision == internal::ProofPrecision::kDoubleDouble) {
+              // Double-double: the allowance is ~1e-30 of the matrix scale.
+              EXPECT_LT(matrix.proven_shift() - sh.c, 1e-20 * s);
+            }
           }
         }
       }
@@ -208,34 +224,34 @@ TEST_F(CertificateTest, FactorizeAgreesWithDenseEigenvalues) {
 
 // The soundness test at the resolution the solver works at: S is shifted so
 // that lambda_min(S) = -2c exactly (dense), for c from 1e-6 ||S|| down to
-// 1e-11 ||S|| (the solver's eta is ~1e-9 F / (d n)). A successful
-// factorization of K_c would be a false certificate unless proven_shift()
-// covers the gap.
+// 1e-11 ||S|| (the solver's eta is ~1e-9 F / (d n)). A successful proof at c
+// would be a false certificate unless proven_shift() covers the gap.
 TEST_F(CertificateTest, NoFalseCertificateAtSmallShifts) {
   for (const RandomGraphOptions& o : Graphs()) {
     instances_.clear();
     Build(o);
-    for (bool strict : {false, true}) {
-      CertificateMatrix matrix(*problem_, strict);
-      const Instance& in = instances_[0];  // The optimum: lambda_min ~ 0.
-      const int d = in.d;
-      const double s = in.scale;
-      for (double relative : {1e-6, 1e-8, 1e-9, 1e-10, 1e-11}) {
-        const double c = relative * s;
-        // Lambda' = Lambda + mu I: lambda_min(Q - Lambda') = lambda_min - mu.
-        const double mu = in.lambda_min + 2 * c;
-        MatrixXd shifted = in.Lambda;
-        for (int i = 0; i < in.n; ++i) {
-          shifted.middleCols(d * i, d) += mu * MatrixXd::Identity(d, d);
-        }
-        const bool ok = matrix.Factorize(shifted, c);
-        if (ok) {
+    CertificateMatrix matrix(*problem_);
+    const Instance& in = instances_[0];  // The optimum: lambda_min ~ 0.
+    const int d = in.d;
+    const double s = in.scale;
+    for (double relative : {1e-6, 1e-8, 1e-9, 1e-10, 1e-11}) {
+      const double c = relative * s;
+      // Lambda' = Lambda + mu I: lambda_min(Q - Lambda') = lambda_min - mu.
+      const double mu = in.lambda_min + 2 * c;
+      MatrixXd shifted = in.Lambda;
+      for (int i = 0; i < in.n; ++i) {
+        shifted.middleCols(d * i, d) += mu * MatrixXd::Identity(d, d);
+      }
+      for (auto precision : {internal::ProofPrecision::kDouble,
+                             internal::ProofPrecision::kDoubleDouble}) {
+        if (matrix.Prove(shifted, c, precision)) {
           // Only acceptable if the proven shift accounts for the gap.
           EXPECT_GE(matrix.proven_shift(), 2 * c * (1 - 1e-6))
               << "FALSE CERTIFICATE: lambda_min(S) = " << -2 * c
               << " but K_c factorized with proven_shift "
               << matrix.proven_shift() << " (c = " << c << ", ||S|| = " << s
-              << ", d " << d << " n " << in.n << ", strict " << strict << ")";
+              << ", d " << d << " n " << in.n << ", "
+              << internal::ProofPrecisionName(precision) << ")";
         }
       }
     }
@@ -249,8 +265,8 @@ TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
     instances_.clear();
     Build(o);
     const MatrixXd M = test_util::DenseDataMatrix(graph_);
-    for (bool strict : {false, true}) {
-      CertificateMatrix matrix(*problem_, strict);
+    for (bool proof : {false, true}) {
+      CertificateMatrix matrix(*problem_);
       if (o.num_loop_closures >= 10 * o.num_poses) {
         EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
       }
@@ -258,11 +274,13 @@ TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
         const int dn = in.d * in.n;
         // lambda_min(S + cI) = 1e-3 ||S||: condition number <= ~1e3.
         const double c = -in.lambda_min + 1e-3 * in.scale;
-        ASSERT_TRUE(matrix.Factorize(in.Lambda, c));
+        ASSERT_TRUE(proof ? matrix.Prove(in.Lambda, c,
+                                         internal::ProofPrecision::kDouble)
+                          : matrix.Factorize(in.Lambda, c));
         // The factor is of K_c with the translation block Lbar - mu I: its
         // Schur complement S_mu + cI, computed densely here.
         const double mu = matrix.translation_shift();
-        EXPECT_EQ(mu > 0, strict);
+        EXPECT_EQ(mu > 0, proof);
         const int n1 = in.n - 1;
         const MatrixXd Lbar =
             M.block(1, 1, n1, n1) - mu * MatrixXd::Identity(n1, n1);
@@ -295,23 +313,35 @@ TEST_F(CertificateTest, VerifyCertificateAgreesWithDenseSpectrum) {
   for (const RandomGraphOptions& o : Graphs()) {
     instances_.clear();
     Build(o);
-    for (bool strict : {false, true}) {
-      CertificateMatrix matrix(*problem_, strict);
+    for (auto policy :
+         {internal::ProofPolicy::kAutomatic, internal::ProofPolicy::kDouble,
+          internal::ProofPolicy::kDoubleDouble}) {
+      CertificateMatrix matrix(*problem_);
       if (o.num_loop_closures >= 10 * o.num_poses) {
         EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
       }
       for (const Instance& in : instances_) {
         const int dn = in.d * in.n;
-        const double eta_target = 1e-9 * in.f / dn;
-        const double eta_max = 1e-6 * in.f / dn;
-        const VerificationResult v = internal::VerifyCertificate(
-            *problem_, in.Lambda, eta_target, eta_max, &matrix);
+        internal::VerificationOptions options;
+        options.eta_target = 1e-9 * in.f / dn;
+        options.eta_goal = 1e-7 * in.f / dn;
+        options.eta_max = 1e-6 * in.f / dn;
+        options.policy = policy;
+        const double eta_max = options.eta_max;
+        const VerificationResult v =
+            internal::VerifyCertificate(*problem_, in.Lambda, options, &matrix);
         SCOPED_TRACE(in.name + " d " + std::to_string(in.d) + " n " +
                      std::to_string(in.n) + " dense lambda_min " +
                      std::to_string(in.lambda_min));
-        EXPECT_GE(v.factorizations, 1);
+        EXPECT_GE(v.factorizations + v.extended_factorizations, 1);
+        if (policy == internal::ProofPolicy::kDouble) {
+          EXPECT_EQ(v.extended_factorizations, 0);
+        }
         if (in.name == "optimum") {
           EXPECT_TRUE(v.certified) << "eta " << v.eta;
+          if (policy != internal::ProofPolicy::kDouble) {
+            EXPECT_LE(v.eta, options.eta_goal);  // Tight, in double-double.
+          }
         } else {
           // Far from optimal: lambda_min(S) is O(1) negative.
           EXPECT_LT(in.lambda_min, -eta_max);
@@ -356,9 +386,12 @@ TEST_F(CertificateTest, VerifyCertificateAgreesWithDenseSpectrum) {
 
         // With a generous eta_max every instance is certified with a sound
         // eta in [-lambda_min, eta_max].
-        const double generous = 4 * std::abs(in.lambda_min) + 1e-6 * in.scale;
-        const VerificationResult w = internal::VerifyCertificate(
-            *problem_, in.Lambda, eta_target, generous, &matrix);
+        internal::VerificationOptions loose = options;
+        loose.eta_max = loose.eta_goal =
+            4 * std::abs(in.lambda_min) + 1e-6 * in.scale;
+        const double generous = loose.eta_max;
+        const VerificationResult w =
+            internal::VerifyCertificate(*problem_, in.Lambda, loose, &matrix);
         EXPECT_TRUE(w.certified);
         EXPECT_LE(w.eta, generous);
         EXPECT_GE(in.lambda_min, -w.eta * (1 + 1e-9) - 1e-13 * in.scale);

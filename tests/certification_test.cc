@@ -98,11 +98,12 @@ TEST(CertificationTest, PerturbedOptimumIsNotCertified) {
   }
 }
 
-// strict_round_off: the proof carries no first-order step (translation-block
-// round-off is bounded rigorously). On small cubes, whose poses are close to
-// pose 0, it still certifies the optimum, in Certify and in Solve, with a
-// lower bound below the optimum; a far-off candidate stays uncertified.
-TEST(CertificationTest, StrictRoundOffCertifiesTheOptimumSoundly) {
+// Every proof arithmetic certifies the optimum of small cubes soundly, in
+// Certify and in Solve (a lower bound below the optimum, reports naming the
+// arithmetic); double-double and the automatic choice reach the goal bound
+// 1e-6; a far-off candidate stays uncertified in every arithmetic.
+TEST(CertificationTest, EveryProofArithmeticCertifiesTheOptimumSoundly) {
+  using Arithmetic = SolverOptions::ProofArithmetic;
   for (int d : {2, 3}) {
     uint64_t seed = 0;
     PoseGraph graph;
@@ -110,40 +111,50 @@ TEST(CertificationTest, StrictRoundOffCertifiesTheOptimumSoundly) {
     SolverSummary summary;
     ASSERT_TRUE(
         SolveCertified(d, d == 2 ? 8 : 4, &seed, &graph, &optimum, &summary));
-    CertifyOptions options;
-    options.strict_round_off = true;
-    Certificate strict, first_order;
-    std::string error;
-    ASSERT_TRUE(Certify(graph, optimum, options, &strict, &error)) << error;
-    ASSERT_TRUE(Certify(graph, optimum, {}, &first_order, &error)) << error;
-    EXPECT_TRUE(strict.certified) << strict.FullReport();
-    EXPECT_TRUE(strict.strict_round_off);
-    EXPECT_FALSE(first_order.strict_round_off);
-    EXPECT_NE(strict.FullReport().find("all round-off rigorous"),
-              std::string::npos);
-    EXPECT_LE(strict.lower_bound, summary.objective);
-    // Both bounds are proven lower bounds of the same optimum, at most
-    // 1e-3 (the certification tolerance) below it.
-    EXPECT_NEAR(strict.lower_bound, first_order.lower_bound,
-                1e-3 * summary.objective);
+    for (Arithmetic arithmetic : {Arithmetic::kAutomatic, Arithmetic::kDouble,
+                                  Arithmetic::kDoubleDouble}) {
+      SCOPED_TRACE(static_cast<int>(arithmetic));
+      CertifyOptions options;
+      options.proof_arithmetic = arithmetic;
+      Certificate certificate;
+      std::string error;
+      ASSERT_TRUE(Certify(graph, optimum, options, &certificate, &error))
+          << error;
+      EXPECT_TRUE(certificate.certified) << certificate.FullReport();
+      EXPECT_LE(certificate.lower_bound, summary.objective);
+      EXPECT_NE(certificate.FullReport().find("proof in " +
+                                              certificate.proof_precision),
+                std::string::npos);
+      if (arithmetic == Arithmetic::kDouble) {
+        EXPECT_EQ(certificate.proof_precision, "double");
+        EXPECT_EQ(certificate.extended_factorizations, 0);
+      } else {
+        EXPECT_LE(certificate.relative_suboptimality_bound, 1e-6);
+      }
+      if (arithmetic == Arithmetic::kDoubleDouble) {
+        EXPECT_EQ(certificate.proof_precision, "double-double");
+        EXPECT_GE(certificate.extended_factorizations, 1);
+      }
 
-    SolverOptions solver_options;
-    solver_options.strict_round_off = true;
-    SolverSummary strict_summary;
-    Solve(graph, solver_options, &strict_summary);
-    EXPECT_TRUE(strict_summary.certified()) << strict_summary.FullReport();
-    EXPECT_TRUE(strict_summary.strict_round_off);
-    EXPECT_LE(strict_summary.lower_bound, summary.objective * (1 + 1e-12));
+      SolverOptions solver_options;
+      solver_options.proof_arithmetic = arithmetic;
+      SolverSummary arithmetic_summary;
+      Solve(graph, solver_options, &arithmetic_summary);
+      EXPECT_TRUE(arithmetic_summary.certified())
+          << arithmetic_summary.FullReport();
+      EXPECT_LE(arithmetic_summary.lower_bound,
+                summary.objective * (1 + 1e-12));
 
-    Poses candidate = optimum;
-    for (int i = 0; i < graph.num_poses; i += 4) {
-      candidate[i].R = -candidate[i].R;         // d = 2: rotation by pi.
-      if (d == 3) candidate[i].R.col(2) *= -1;  // Keeps det = +1.
+      Poses candidate = optimum;
+      for (int i = 0; i < graph.num_poses; i += 4) {
+        candidate[i].R = -candidate[i].R;         // d = 2: rotation by pi.
+        if (d == 3) candidate[i].R.col(2) *= -1;  // Keeps det = +1.
+      }
+      Certificate far;
+      ASSERT_TRUE(Certify(graph, candidate, options, &far, &error)) << error;
+      EXPECT_FALSE(far.certified);
+      EXPECT_LE(far.lower_bound, summary.objective * (1 + 1e-9));
     }
-    Certificate far;
-    ASSERT_TRUE(Certify(graph, candidate, options, &far, &error)) << error;
-    EXPECT_FALSE(far.certified);
-    EXPECT_LE(far.lower_bound, summary.objective * (1 + 1e-9));
   }
 }
 

@@ -11,7 +11,8 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "tests/util/cli_test_util.h"
+#include "tests/util/json_validator.h"
+#include "tests/util/tool_runner.h"
 
 namespace ceres_sesync {
 namespace {
@@ -21,7 +22,7 @@ using test_util::IsValidJson;
 using test_util::JsonNumber;
 using test_util::ReadText;
 using test_util::RunResult;
-using test_util::RunTool;
+using test_util::RunToolWithOutput;
 using test_util::TempPath;
 using test_util::WriteText;
 using testing::HasSubstr;
@@ -42,7 +43,7 @@ TEST_F(CliTest, HelpListsTheCommandsOwnFlagsWithTheirDefaults) {
   for (const char* args :
        {"help generate", "generate --help", "generate cube --help"}) {
     SCOPED_TRACE(args);
-    const RunResult run = RunTool(args);
+    const RunResult run = RunToolWithOutput(args);
     EXPECT_EQ(run.exit_code, 0) << run.output;
     EXPECT_THAT(run.out, HasSubstr("usage: ceres_sesync generate cube"));
     for (const char* flag :
@@ -57,7 +58,7 @@ TEST_F(CliTest, HelpListsTheCommandsOwnFlagsWithTheirDefaults) {
       EXPECT_THAT(run.out, Not(HasSubstr(other)));
     }
   }
-  const RunResult solve = RunTool("solve --help");
+  const RunResult solve = RunToolWithOutput("solve --help");
   EXPECT_EQ(solve.exit_code, 0);
   for (const char* flag :
        {"--components=false\n", "--progress=false\n", "--max_rank=10\n",
@@ -67,17 +68,17 @@ TEST_F(CliTest, HelpListsTheCommandsOwnFlagsWithTheirDefaults) {
   EXPECT_THAT(solve.out, Not(HasSubstr("--side")));
   EXPECT_THAT(solve.out, Not(HasSubstr("logtostderr")));
 
-  const RunResult general = RunTool("help");
+  const RunResult general = RunToolWithOutput("help");
   EXPECT_EQ(general.exit_code, 0);
   for (const char* command : kCommands) {
     EXPECT_THAT(general.out, HasSubstr(std::string("\n  ") + command + " "));
   }
-  EXPECT_EQ(RunTool("help nosuchcommand").exit_code, 2);
+  EXPECT_EQ(RunToolWithOutput("help nosuchcommand").exit_code, 2);
 }
 
 TEST_F(CliTest, EveryFlagOfTheProgramIsListedByACommand) {
   // gflags' XML lists every flag with the file that defines it.
-  const RunResult xml = RunTool("--helpxml");
+  const RunResult xml = RunToolWithOutput("--helpxml");
   const std::regex flag("<flag><file>([^<]*)</file><name>([^<]*)</name>");
   std::set<std::string> program_flags;
   for (auto it = std::sregex_iterator(xml.out.begin(), xml.out.end(), flag);
@@ -90,7 +91,7 @@ TEST_F(CliTest, EveryFlagOfTheProgramIsListedByACommand) {
   ASSERT_GE(program_flags.size(), 25u) << xml.out.substr(0, 2000);
   std::string all_help;
   for (const char* command : kCommands) {
-    all_help += RunTool(std::string("help ") + command).out;
+    all_help += RunToolWithOutput(std::string("help ") + command).out;
   }
   for (const std::string& name : program_flags) {
     EXPECT_THAT(all_help, HasSubstr("\n  --" + name + "=")) << name;
@@ -99,17 +100,19 @@ TEST_F(CliTest, EveryFlagOfTheProgramIsListedByACommand) {
 
 TEST_F(CliTest, UnknownAndForeignFlagsAreUsageErrors) {
   const std::string output = TempPath("flags.g2o");
-  RunResult run = RunTool("generate cube --bogus 1 --output " + output);
+  RunResult run =
+      RunToolWithOutput("generate cube --bogus 1 --output " + output);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.err, HasSubstr("unknown flag '--bogus'"));
-  run = RunTool("generate cube --tum x.tum --output " + output);
+  run = RunToolWithOutput("generate cube --tum x.tum --output " + output);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.err, HasSubstr("--tum is not a flag of this command"));
   EXPECT_FALSE(fs::exists(output));
   // Negated booleans and "--flag value" are flags too; glog's are accepted.
-  run = RunTool("generate cube --side 3 --noverbose --v=0 --output " + output);
+  run = RunToolWithOutput("generate cube --side 3 --noverbose --v=0 --output " +
+                          output);
   EXPECT_EQ(run.exit_code, 2) << run.output;  // --verbose is not generate's.
-  run = RunTool("generate cube --side 3 --v=0 --output " + output);
+  run = RunToolWithOutput("generate cube --side 3 --v=0 --output " + output);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   EXPECT_TRUE(fs::exists(output));
   fs::remove(output);
@@ -129,8 +132,8 @@ TEST_F(CliTest, SolveComponents) {
   const std::string json_path = TempPath("two.json");
   const std::string poses = TempPath("two_poses.g2o");
   WriteText(graph, kTwoComponents);
-  RunResult run =
-      RunTool("solve " + graph + " --json " + json_path + " --output " + poses);
+  RunResult run = RunToolWithOutput("solve " + graph + " --json " + json_path +
+                                    " --output " + poses);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.err,
               HasSubstr(graph + ":4: measurement graph is disconnected"));
@@ -138,8 +141,8 @@ TEST_F(CliTest, SolveComponents) {
   EXPECT_FALSE(fs::exists(json_path));
   EXPECT_FALSE(fs::exists(poses));
 
-  run = RunTool("solve " + graph + " --components --json " + json_path +
-                " --output " + poses);
+  run = RunToolWithOutput("solve " + graph + " --components --json " +
+                          json_path + " --output " + poses);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_THAT(run.out, HasSubstr("Connected components"));
   const std::string json = ReadText(json_path);
@@ -168,13 +171,15 @@ TEST_F(CliTest, SolveComponents) {
 
 TEST_F(CliTest, ProgressOnlyWhenAskedForOnAPipe) {
   const std::string graph = TempPath("cube.g2o");
-  ASSERT_EQ(RunTool("generate cube --side 4 --output " + graph).exit_code, 0);
-  RunResult run = RunTool("solve " + graph);
+  ASSERT_EQ(
+      RunToolWithOutput("generate cube --side 4 --output " + graph).exit_code,
+      0);
+  RunResult run = RunToolWithOutput("solve " + graph);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(run.err, "");  // stderr is not a terminal.
-  run = RunTool("solve " + graph + " --noprogress");
+  run = RunToolWithOutput("solve " + graph + " --noprogress");
   EXPECT_EQ(run.err, "");
-  run = RunTool("solve " + graph + " --progress");
+  run = RunToolWithOutput("solve " + graph + " --progress");
   EXPECT_EQ(run.exit_code, 0) << run.output;
   // One line per stage, in order.
   size_t at = 0;

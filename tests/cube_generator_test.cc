@@ -4,8 +4,6 @@
 
 #include "ceres_sesync/cube_generator.h"
 
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +17,7 @@
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/langevin.h"
 #include "gtest/gtest.h"
+#include "tests/util/tool_runner.h"
 
 namespace ceres_sesync {
 namespace {
@@ -443,16 +442,10 @@ TEST(GenerateCube, RejectsInvalidOptions) {
   }
 }
 
-// Runs the tool with `arguments`; returns its exit code.
-int RunTool(const std::string& arguments) {
-  const std::string command =
-      std::string(CERES_SESYNC_TOOL) + " " + arguments + " >/dev/null 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using test_util::RunTool;
 
 TEST(GenerateCommand, WritesTheGeneratedGraph) {
-  if (std::string(CERES_SESYNC_TOOL).empty()) {
+  if (!test_util::ToolBuilt()) {
     GTEST_SKIP() << "the ceres_sesync tool is not built";
   }
   const std::string dir = std::string(CERES_SESYNC_BINARY_DIR);
@@ -516,9 +509,7 @@ TEST(GenerateCommand, WritesTheGeneratedGraph) {
   EXPECT_EQ(RunTool("generate cube --dimension 4 --output " + output), 2);
   EXPECT_EQ(RunTool("generate cube --kappa -1 --output " + output), 2);
   EXPECT_EQ(RunTool("generate cube --vertices bogus --output " + output), 2);
-  FILE* f = std::fopen(output.c_str(), "r");
-  EXPECT_EQ(f, nullptr) << "a failed run left " << output;
-  if (f) std::fclose(f);
+  EXPECT_FALSE(test_util::FileExists(output)) << "a failed run left " << output;
   std::remove(truth_path.c_str());
 }
 

@@ -10,7 +10,8 @@
 
 #include "ceres_sesync/internal/json_writer.h"
 #include "gtest/gtest.h"
-#include "tests/util/cli_test_util.h"
+#include "tests/util/json_validator.h"
+#include "tests/util/tool_runner.h"
 
 namespace ceres_sesync {
 namespace {
@@ -20,7 +21,7 @@ using test_util::IsValidJson;
 using test_util::JsonNumber;
 using test_util::ReadText;
 using test_util::RunResult;
-using test_util::RunTool;
+using test_util::RunToolWithOutput;
 using test_util::TempPath;
 using test_util::ValueAfter;
 using test_util::WriteText;
@@ -126,7 +127,8 @@ TEST_F(InfoCommandTest, DescribesAGoodFile) {
   const std::string graph = TempPath("good.g2o");
   const std::string json_path = TempPath("good.json");
   WriteText(graph, kGoodGraph);
-  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  const RunResult run =
+      RunToolWithOutput("info " + graph + " --json " + json_path);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "dimension:"), "2") << run.output;
   EXPECT_EQ(ValueAfter(run.output, "poses:"), "3") << run.output;
@@ -167,7 +169,8 @@ TEST_F(InfoCommandTest, BadFileExitsWithTwoNamingTheLineAndWritesNoJson) {
             "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
             "\n"
             "EDGE_SE2 1 2 1 0 0 1 0 0 1 0 oops\n");
-  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  const RunResult run =
+      RunToolWithOutput("info " + graph + " --json " + json_path);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(run.output.find(graph + ":3: "), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(json_path));
@@ -180,14 +183,14 @@ TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
   WriteText(graph,
             "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
             "VERTEX_XY 5 1 2\n");
-  RunResult run = RunTool("info " + graph);
+  RunResult run = RunToolWithOutput("info " + graph);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(run.output.find(graph + ":2: unsupported tag 'VERTEX_XY'"),
             std::string::npos)
       << run.output;
 
-  run =
-      RunTool("info " + graph + " --skip_unsupported_tags --json " + json_path);
+  run = RunToolWithOutput("info " + graph + " --skip_unsupported_tags --json " +
+                          json_path);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "skipped lines:"), "1") << run.output;
   const std::string json = ReadText(json_path);
@@ -199,15 +202,16 @@ TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
 }
 
 TEST_F(InfoCommandTest, UsageErrorsExitWithTwo) {
-  EXPECT_EQ(RunTool("info").exit_code, 2);
+  EXPECT_EQ(RunToolWithOutput("info").exit_code, 2);
   const std::string missing = TempPath("missing.g2o");
-  const RunResult run = RunTool("info " + missing);
+  const RunResult run = RunToolWithOutput("info " + missing);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.output.find(missing), std::string::npos) << run.output;
   // An unwritable --json path is an error too.
   const std::string graph = TempPath("good2.g2o");
   WriteText(graph, kGoodGraph);
-  EXPECT_EQ(RunTool("info " + graph + " --json " + TempPath("no_dir/x.json"))
+  EXPECT_EQ(RunToolWithOutput("info " + graph + " --json " +
+                              TempPath("no_dir/x.json"))
                 .exit_code,
             2);
   fs::remove(graph);
@@ -216,7 +220,7 @@ TEST_F(InfoCommandTest, UsageErrorsExitWithTwo) {
 TEST_F(InfoCommandTest, DescribesABenchmarkDataset) {
   const std::string path = std::string(CERES_SESYNC_DATA_DIR) + "/CSAIL.g2o";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
-  const RunResult run = RunTool("info " + path);
+  const RunResult run = RunToolWithOutput("info " + path);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "edges:"), "1172") << run.output;
   EXPECT_EQ(ValueAfter(run.output, "poses:"), "1045") << run.output;

@@ -23,10 +23,10 @@
 DEFINE_string(json, "", "Write a machine-readable JSON summary to this path.");
 DEFINE_string(output, "", "Write the resulting poses (g2o) to this path.");
 DEFINE_bool(verbose, false, "Log solver progress to stderr (glog INFO).");
-DEFINE_bool(strict_round_off, false,
-            "Account rigorously for the round-off of the certificate's "
-            "translation block (SolverOptions::strict_round_off); large maps "
-            "may then not certify.");
+DEFINE_string(proof_arithmetic, "automatic",
+              "Arithmetic of the certificate's proof: 'automatic' (double, "
+              "then double-double when double cannot reach the goal bound), "
+              "'double' or 'double-double'.");
 DEFINE_int32(num_threads, 0, "Threads for the O(m r) kernels (0: all cores).");
 
 namespace {
@@ -81,7 +81,7 @@ const std::vector<Command>& Commands() {
         {"gradient_tolerance"},
         {"max_time"},
         {"num_threads"},
-        {"strict_round_off"},
+        {"proof_arithmetic"},
         {"progress"},
         {"verbose"}}},
       {"certify",
@@ -98,18 +98,22 @@ const std::vector<Command>& Commands() {
          "With --improve: write the improved poses to this g2o "
          "file."},
         {"num_threads"},
-        {"strict_round_off"},
+        {"proof_arithmetic"},
         {"progress", "With --improve: show the solve's progress (see solve)."},
         {"verbose"}}},
       {"generate",
        ceres_sesync::tools::RunGenerate,
-       "cube",
-       "write the paper's synthetic cube benchmark",
-       "Writes the synthetic cube benchmark of SE-Sync's Section 6.1: a "
-       "boustrophedon path through an s x s x s lattice (s x s in 2D) with "
-       "odometry, random loop closures and noise of the paper's model.",
+       "cube|city",
+       "write a synthetic pose graph (cube, city)",
+       "'generate cube' writes the synthetic cube benchmark of SE-Sync's "
+       "Section 6.1: a boustrophedon path through an s x s x s lattice (s x s "
+       "in 2D) with odometry, random loop closures and noise of the paper's "
+       "model. 'generate city' writes a large Manhattan-style random walk "
+       "(--poses N) for scaling studies, with loop closures at revisited "
+       "places.",
        {{"output", "Write the generated graph to this g2o file (required)."},
         {"side"},
+        {"poses"},
         {"dimension"},
         {"loop_closure_probability"},
         {"loop_closure_radius"},

@@ -43,8 +43,14 @@ int RunCertify(const Args& args) {
   options.max_relative_suboptimality = FLAGS_max_relative_suboptimality;
   options.improve_if_not_certified = FLAGS_improve;
   options.num_threads = FLAGS_num_threads;
-  options.strict_round_off = FLAGS_strict_round_off;
-  options.solver_options.strict_round_off = FLAGS_strict_round_off;
+  if (!ParseProofArithmetic(FLAGS_proof_arithmetic,
+                            &options.proof_arithmetic)) {
+    std::fprintf(stderr,
+                 "ceres_sesync certify: unknown --proof_arithmetic '%s'\n",
+                 FLAGS_proof_arithmetic.c_str());
+    return kUsageOrInputError;
+  }
+  options.solver_options.proof_arithmetic = options.proof_arithmetic;
   options.solver_options.num_threads = FLAGS_num_threads;
   options.solver_options.verbose = FLAGS_verbose;
   std::unique_ptr<ProgressPrinter> progress;
@@ -72,7 +78,14 @@ int RunCertify(const Args& args) {
     json.Number("rotation_objective", certificate.rotation_objective);
     json.Number("lambda_min", certificate.lambda_min);
     json.Number("eta", certificate.eta);
-    json.Bool("strict_round_off", certificate.strict_round_off);
+    // Every proof accounts for all round-off (the key is kept for scripts).
+    json.Bool("strict_round_off", true);
+    json.BeginObject("proof");
+    json.String("precision", certificate.proof_precision);
+    json.Int("factorizations", certificate.factorizations);
+    json.Int("extended_factorizations", certificate.extended_factorizations);
+    json.Number("extended_time_s", certificate.extended_proof_time_s);
+    json.EndObject();
     json.Number("lower_bound", certificate.lower_bound);
     json.Number("suboptimality_bound", certificate.suboptimality_bound);
     json.Number("relative_suboptimality_bound",

@@ -12,13 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "ceres_sesync/sesync_solver.h"
 #include "gflags/gflags.h"
 
 DECLARE_string(json);
 DECLARE_string(output);
 DECLARE_bool(verbose);
 DECLARE_int32(num_threads);
-DECLARE_bool(strict_round_off);
+DECLARE_string(proof_arithmetic);
 
 namespace ceres_sesync::tools {
 
@@ -30,6 +31,11 @@ int RunInfo(const Args& args);
 int RunSolve(const Args& args);
 int RunCertify(const Args& args);
 int RunGenerate(const Args& args);
+
+// --proof_arithmetic: "automatic", "double" or "double-double"; false for
+// anything else.
+bool ParseProofArithmetic(const std::string& name,
+                          SolverOptions::ProofArithmetic* arithmetic);
 
 }  // namespace ceres_sesync::tools
 

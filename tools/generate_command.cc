@@ -1,30 +1,39 @@
-// `ceres_sesync generate cube ...`: writes a synthetic cube (or 2D grid)
-// pose graph of SE-Sync's Section 6.1 (see ceres_sesync/cube_generator.h).
+// `ceres_sesync generate cube|city ...`: writes a synthetic pose graph: the
+// cube (or 2D grid) of SE-Sync's Section 6.1 (ceres_sesync/cube_generator.h)
+// or a large Manhattan-style city walk (ceres_sesync/city_generator.h).
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
+#include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/pose_graph.h"
 #include "gflags/gflags.h"
 #include "tools/commands.h"
 
-DEFINE_int32(side, 10, "Side length s of the lattice, in poses.");
-DEFINE_int32(dimension, 3, "3 for the s x s x s cube, 2 for the s x s grid.");
+DEFINE_int32(side, 10, "Cube: side length s of the lattice, in poses.");
+DEFINE_int32(poses, 0, "City: number of poses n (required).");
+DEFINE_int32(dimension, 3,
+             "Cube: 3 for the s x s x s cube, 2 for the s x s "
+             "grid; city: 2 (default) or 3.");
 DEFINE_double(loop_closure_probability, 0.1,
-              "Probability pLC of a loop closure between each pair "
-              "of nearby non-sequential poses.");
+              "Cube: probability pLC of a loop closure between "
+              "each pair of nearby non-sequential poses; city (default 0.3): "
+              "probability of a closure to each earlier pose at a revisited "
+              "lattice node (at most 2 per visit).");
 DEFINE_double(loop_closure_radius, 1.0,
-              "Loop-closure candidates are non-consecutive poses "
-              "at most this many lattice units apart, in [1, 4] (1: lattice "
-              "neighbours; sqrt(3): the 3 x 3 x 3 block).");
+              "Cube: loop-closure candidates are non-consecutive "
+              "poses at most this many lattice units apart, in [1, 4] (1: "
+              "lattice neighbours; sqrt(3): the 3 x 3 x 3 block).");
 DEFINE_double(kappa, 16.67,
               "Rotational concentration of every measurement "
-              "(16.67 ~ 10 deg RMS).");
+              "(cube default 16.67 ~ 10 deg RMS; city default 100 ~ 4 deg).");
 DEFINE_double(tau, 75,
-              "Translational precision of every measurement (75 ~ "
-              "0.2 m RMS in 3D).");
+              "Translational precision of every measurement (cube "
+              "default 75 ~ 0.2 m RMS in 3D; city default 100).");
 DEFINE_uint64(seed, 0, "Random seed (deterministic output).");
 DEFINE_string(ground_truth, "",
               "Also write the ground-truth poses (VERTEX lines) to "
@@ -42,7 +51,16 @@ constexpr char kUsage[] =
     "usage: ceres_sesync generate cube --side S [--dimension 2|3] "
     "[--loop_closure_probability P] [--loop_closure_radius R] [--kappa K] "
     "[--tau T] [--seed N] --output FILE.g2o [--ground_truth FILE.g2o] "
+    "[--vertices odometry|ground_truth|none]\n"
+    "       ceres_sesync generate city --poses N [--dimension 2|3] "
+    "[--loop_closure_probability P] [--kappa K] [--tau T] [--seed N] "
+    "--output FILE.g2o [--ground_truth FILE.g2o] "
     "[--vertices odometry|ground_truth|none]\n";
+
+// Whether `flag` was given on the command line.
+bool IsSet(const char* flag) {
+  return !gflags::GetCommandLineFlagInfoOrDie(flag).is_default;
+}
 
 int UsageError(const std::string& message) {
   std::fprintf(stderr, "ceres_sesync generate: %s\n%s", message.c_str(),
@@ -64,9 +82,10 @@ Poses DeadReckoning(const PoseGraph& graph) {
 }  // namespace
 
 int RunGenerate(const Args& args) {
-  if (args.empty()) return UsageError("missing the model name (cube)");
-  if (args[0] != "cube") {
-    return UsageError("unknown model '" + args[0] + "' (only 'cube')");
+  if (args.empty()) return UsageError("missing the model name (cube or city)");
+  const std::string& model = args[0];
+  if (model != "cube" && model != "city") {
+    return UsageError("unknown model '" + model + "' (cube or city)");
   }
   if (args.size() > 1) {
     return UsageError("unexpected argument '" + args[1] + "'");
@@ -77,18 +96,62 @@ int RunGenerate(const Args& args) {
     return UsageError("--vertices must be odometry, ground_truth or none");
   }
 
-  CubeOptions options;
-  options.dimension = FLAGS_dimension;
-  options.side = FLAGS_side;
-  options.loop_closure_probability = FLAGS_loop_closure_probability;
-  options.loop_closure_radius = FLAGS_loop_closure_radius;
-  options.kappa = FLAGS_kappa;
-  options.tau = FLAGS_tau;
-  options.seed = FLAGS_seed;
   PoseGraph graph;
   Poses truth;
   std::string error;
-  if (!GenerateCube(options, &graph, &truth, &error)) return UsageError(error);
+  std::string size;  // "side=S" or "lattice=AxB[xC]", for the report.
+  double kappa = 0;
+  if (model == "cube") {
+    if (IsSet("poses")) {
+      return UsageError("--poses is for 'generate city' (the cube has --side)");
+    }
+    CubeOptions options;
+    options.dimension = FLAGS_dimension;
+    options.side = FLAGS_side;
+    options.loop_closure_probability = FLAGS_loop_closure_probability;
+    options.loop_closure_radius = FLAGS_loop_closure_radius;
+    options.kappa = FLAGS_kappa;
+    options.tau = FLAGS_tau;
+    options.seed = FLAGS_seed;
+    if (!GenerateCube(options, &graph, &truth, &error)) {
+      return UsageError(error);
+    }
+    size = "side=" + std::to_string(options.side);
+    kappa = options.kappa;
+  } else {
+    if (IsSet("side")) {
+      return UsageError("--side is for 'generate cube' (the city has --poses)");
+    }
+    if (IsSet("loop_closure_radius")) {
+      return UsageError("--loop_closure_radius is for 'generate cube'");
+    }
+    if (!IsSet("poses")) return UsageError("--poses N is required");
+    // Flags not given keep CityOptions' defaults (which differ from the
+    // cube's flag defaults).
+    CityOptions options;
+    options.num_poses = FLAGS_poses;
+    if (IsSet("dimension")) options.dimension = FLAGS_dimension;
+    if (IsSet("loop_closure_probability")) {
+      options.loop_closure_probability = FLAGS_loop_closure_probability;
+    }
+    if (IsSet("kappa")) options.kappa = FLAGS_kappa;
+    if (IsSet("tau")) options.tau = FLAGS_tau;
+    options.seed = FLAGS_seed;
+    if (!GenerateCity(options, &graph, &truth, &error)) {
+      return UsageError(error);
+    }
+    // The lattice extent actually covered by the walk, in nodes per axis.
+    for (int k = 0; k < graph.dimension; ++k) {
+      double lo = 0, hi = 0;
+      for (const Pose& pose : truth) {
+        lo = std::min(lo, pose.t[k]);
+        hi = std::max(hi, pose.t[k]);
+      }
+      size += (k == 0 ? "lattice=" : "x") +
+              std::to_string(std::lround((hi - lo) / options.spacing) + 1);
+    }
+    kappa = options.kappa;
+  }
 
   Poses vertices;
   if (FLAGS_vertices == "odometry") {
@@ -109,13 +172,12 @@ int RunGenerate(const Args& args) {
   const int m = static_cast<int>(graph.measurements.size());
   const int loop_closures = m - (graph.num_poses - 1);
   std::printf(
-      "cube: d=%d side=%d poses=%d measurements=%d (odometry %d, loop "
-      "closures %d)\n"
+      "%s: d=%d %s poses=%d measurements=%d (odometry %d, loop closures %d)\n"
       "objective at ground truth %.6e (expected %.6e over the noise)\n"
       "wrote %s%s%s\n",
-      graph.dimension, options.side, graph.num_poses, m, graph.num_poses - 1,
-      loop_closures, EvaluateObjective(graph, truth),
-      ExpectedGroundTruthObjective(graph.dimension, m, options.kappa),
+      model.c_str(), graph.dimension, size.c_str(), graph.num_poses, m,
+      graph.num_poses - 1, loop_closures, EvaluateObjective(graph, truth),
+      ExpectedGroundTruthObjective(graph.dimension, m, kappa),
       FLAGS_output.c_str(), FLAGS_ground_truth.empty() ? "" : " and ",
       FLAGS_ground_truth.c_str());
   return kSuccess;

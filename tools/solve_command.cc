@@ -53,12 +53,21 @@ void AddSummary(const SolverSummary& summary, internal::JsonWriter* json) {
   json->Number("rounding_gap", summary.rounding_gap);
   json->Number("lambda_min", summary.lambda_min_estimate);
   json->Number("eta", summary.eta);
-  json->Bool("strict_round_off", summary.strict_round_off);
+  // Every proof accounts for all round-off (the key is kept for scripts).
+  json->Bool("strict_round_off", true);
   json->Bool("certified", summary.certified());
+  json->Bool("relaxation_exact", summary.relaxation_exact);
   json->Int("rank", summary.final_rank);
   json->String("status", summary.StatusString());
   json->Int("iterations", summary.iterations);
   json->Int("hessian_vector_products", summary.hessian_vector_products);
+  json->BeginObject("proof");
+  json->String("precision", summary.proof_precision);
+  json->Int("factorizations", summary.factorizations);
+  json->Int("extended_factorizations", summary.extended_factorizations);
+  json->Number("extended_time_s", summary.extended_proof_time_s);
+  json->Number("verification_time_s", summary.verification_time_s);
+  json->EndObject();
   json->BeginObject("time_s");
   json->Number("data", summary.data_time_s);
   json->Number("initialization", summary.initialization_time_s);
@@ -144,7 +153,11 @@ int RunSolve(const Args& args) {
   options.max_time_s = FLAGS_max_time;
   options.verbose = FLAGS_verbose;
   options.num_threads = FLAGS_num_threads;
-  options.strict_round_off = FLAGS_strict_round_off;
+  if (!ParseProofArithmetic(FLAGS_proof_arithmetic,
+                            &options.proof_arithmetic)) {
+    return InputError("unknown --proof_arithmetic '" + FLAGS_proof_arithmetic +
+                      "'");
+  }
   options.relative_preconditioned_gradient_tolerance = FLAGS_gradient_tolerance;
 
   const std::string& path = args[0];
@@ -202,6 +215,20 @@ int RunSolve(const Args& args) {
     return InputError(error);
   }
   return certified ? kSuccess : kNotCertified;
+}
+
+bool ParseProofArithmetic(const std::string& name,
+                          SolverOptions::ProofArithmetic* arithmetic) {
+  if (name == "automatic") {
+    *arithmetic = SolverOptions::ProofArithmetic::kAutomatic;
+  } else if (name == "double") {
+    *arithmetic = SolverOptions::ProofArithmetic::kDouble;
+  } else if (name == "double-double") {
+    *arithmetic = SolverOptions::ProofArithmetic::kDoubleDouble;
+  } else {
+    return false;
+  }
+  return true;
 }
 
 }  // namespace ceres_sesync::tools

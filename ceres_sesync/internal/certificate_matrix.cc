@@ -1,8 +1,12 @@
 #include "ceres_sesync/internal/certificate_matrix.h"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <limits>
 
+#include "ceres_sesync/internal/double_double.h"
+#include "ceres_sesync/internal/extended_cholesky.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
@@ -31,9 +35,12 @@ std::vector<int> BlockOrdering(const SESyncProblem& problem) {
 
 }  // namespace
 
-CertificateMatrix::CertificateMatrix(const SESyncProblem& problem,
-                                     bool strict_round_off)
-    : strict_round_off_(strict_round_off),
+const char* ProofPrecisionName(ProofPrecision precision) {
+  return precision == ProofPrecision::kDouble ? "double" : "double-double";
+}
+
+CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
+    : problem_(problem),
       d_(problem.dimension()),
       n_(problem.num_poses()),
       translation_size_(problem.num_poses() - 1),
@@ -82,8 +89,6 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem,
     const int k = K_.outerIndexPtr()[j];
     CHECK_EQ(K_.innerIndexPtr()[k], j);
     translation_diagonal_.push_back(k);
-    max_translation_diagonal_ =
-        std::max(max_translation_diagonal_, std::abs(base_values_[k]));
   }
   block_entry_.reserve(n_ * d * (d + 1) / 2);
   for (int i = 0; i < n_; ++i) {
@@ -97,20 +102,39 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem,
       }
     }
   }
+  data_rounding_.resize(size);
+  for (int j = 0; j < t0; ++j) {
+    data_rounding_[j] = problem.translation_row_rounding()[j + 1];
+  }
+  for (int q = 0; q < rotation_size_; ++q) {
+    data_rounding_[t0 + q] = problem.rotation_row_rounding()[q];
+  }
   // The translation rows of K's factor carry round-off of the size of
-  // Lbar's own factorization (4-25x its bound on the benchmark datasets).
-  if (strict_round_off_) translation_shift_ = 64 * problem.LbarBackwardError();
+  // Lbar's own factorization (4-25x its bound on the benchmark datasets);
+  // both shifts adapt to the bounds they meet.
+  double data_head = 0;
+  for (int j = 0; j < t0; ++j)
+    data_head = std::max(data_head, data_rounding_[j]);
+  double_shift_ = 64 * problem.LbarBackwardError() + 2 * data_head;
+  extended_shift_ = double_shift_ * kDoubleDoubleUnitRoundoff / kUnitRoundoff;
+  ordering_ = BlockOrdering(problem);
   ConfigureCholmod(CholmodLayout::kAutomatic, &factor_);
-  factor_.AnalyzePatternWithOrdering(K_, BlockOrdering(problem));
+  factor_.AnalyzePatternWithOrdering(K_, ordering_);
 }
 
+CertificateMatrix::~CertificateMatrix() = default;
+
 void CertificateMatrix::Assemble(const Eigen::MatrixXd& Lambda, double c,
-                                 double translation_shift,
-                                 double* rotation_rounding) {
+                                 double mu, std::vector<double>* rounding) {
   std::copy(base_values_.begin(), base_values_.end(), K_.valuePtr());
-  for (int k : translation_diagonal_) K_.valuePtr()[k] -= translation_shift;
-  const int d = d_;
-  double max_row = 0;
+  rounding->assign(K_.rows(), 0.0);
+  // Lbar_jj - mu: one rounding.
+  for (int j = 0; j < translation_size_; ++j) {
+    double& value = K_.valuePtr()[translation_diagonal_[j]];
+    (*rounding)[j] = 2 * kUnitRoundoff * (std::abs(value) + mu);
+    value -= mu;
+  }
+  const int d = d_, t0 = translation_size_;
   int k = 0;
   for (int i = 0; i < n_; ++i) {
     double row_sum[3] = {0, 0, 0};
@@ -123,55 +147,219 @@ void CertificateMatrix::Assemble(const Eigen::MatrixXd& Lambda, double c,
         if (a != b) row_sum[b] += std::abs(value);
       }
     }
-    for (int a = 0; a < d; ++a) max_row = std::max(max_row, row_sum[a]);
+    // Two roundings per entry (- Lambda, + c): each assembled entry is
+    // within 2u (|entry| + c) of its exact value (4u to cover second-order
+    // terms); Gershgorin over the d x d block.
+    for (int a = 0; a < d; ++a) {
+      (*rounding)[t0 + d * i + a] = 4 * kUnitRoundoff * (row_sum[a] + c);
+    }
   }
-  // Two roundings per entry (- Lambda, + c): each assembled entry is within
-  // 2u (|entry| + c) of its exact value (4u to cover second-order terms);
-  // Gershgorin over the d x d blocks.
-  *rotation_rounding = 4 * kUnitRoundoff * (max_row + c);
 }
 
-bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c,
-                                  bool bound_backward_error) {
-  if (!bound_backward_error) {
-    double unused;
-    Assemble(Lambda, c, 0, &unused);
-    factorized_shift_ = 0;
-    factor_.factorize(K_);
-    backward_error_ = proven_shift_ = std::numeric_limits<double>::quiet_NaN();
-    return factor_.info() == Eigen::Success;
-  }
-  // Strict: with K' = K_c - diag(mu I, 0) factorized, the backward error
-  // bounds give K' + diag(h I, t I) >= 0 (CholmodFactor::BackwardErrorBound,
-  // plus the rounding of the assembly). If h <= mu, then
-  // [Lbar, -Vbar; -Vbar^T, D - Lambda + (c + t) I] >= 0, whose Schur
-  // complement is S + (c + t) I: lambda_min(S) >= -(c + t), with no error
-  // amplified through Lbar^{-1}. mu starts from 64x Lbar's own error bound
-  // and grows to twice any bound h that exceeded it. Default (mu = 0): the
-  // same bounds, max(h, t) added to c, which proves K_c + max(h, t) I >= 0.
+bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c) {
+  std::vector<double> unused;
+  Assemble(Lambda, c, 0, &unused);
+  factorized_shift_ = 0;
+  ++double_factorizations_;
+  factor_.factorize(K_);
+  return factor_.info() == Eigen::Success;
+}
+
+bool CertificateMatrix::Prove(const Eigen::MatrixXd& Lambda, double c,
+                              ProofPrecision precision) {
+  proven_shift_ = backward_error_ = std::numeric_limits<double>::infinity();
+  return precision == ProofPrecision::kDouble ? ProveDouble(Lambda, c)
+                                              : ProveDoubleDouble(Lambda, c);
+}
+
+bool CertificateMatrix::SettleShift(double head, double* mu) const {
+  if (head <= *mu) return true;
+  *mu = 2 * head;  // Too small: the next attempt covers this bound twice.
+  return false;
+}
+
+bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
+  const int t0 = translation_size_;
   for (int attempt = 0; attempt < 3; ++attempt) {
-    const double mu = strict_round_off_ ? translation_shift_ : 0;
-    double rotation_rounding = 0;
-    Assemble(Lambda, c, mu, &rotation_rounding);
+    const double mu = double_shift_;
+    std::vector<double> rounding, rho;
+    Assemble(Lambda, c, mu, &rounding);
     factorized_shift_ = mu;
+    ++double_factorizations_;
     factor_.factorize(K_);
     if (factor_.info() != Eigen::Success) return false;
+    factor_.RowBackwardErrorBounds(&rho);
     double head = 0, tail = 0;
-    factor_.BackwardErrorBound(translation_size_, &head, &tail);
-    head += 4 * kUnitRoundoff * (max_translation_diagonal_ + mu);
-    tail += rotation_rounding;
-    if (!strict_round_off_ || head <= mu) {
-      backward_error_ = strict_round_off_ ? tail : std::max(head, tail);
-      proven_shift_ = c + backward_error_;
-      VLOG(1) << "K_c factorized: c " << c << " backward error "
-              << backward_error_ << " (translation rows " << head << ", shift "
-              << mu << ")";
+    for (int i = 0; i < static_cast<int>(rho.size()); ++i) {
+      const double bound = rho[i] + rounding[i] + data_rounding_[i];
+      double& side = i < t0 ? head : tail;
+      side = std::max(side, bound);
+    }
+    if (SettleShift(head, &double_shift_)) {
+      backward_error_ = tail;
+      proven_shift_ = c + tail;
+      // Next time start closer to what this one needed.
+      double_shift_ = std::max(1.5 * head, std::numeric_limits<double>::min());
+      VLOG(1) << "K_c proven (double): c " << c << " backward error " << tail
+              << " (translation rows " << head << ", shift " << mu << ")";
       return true;
     }
-    translation_shift_ = 2 * head;
   }
   LOG(WARNING) << "certificate matrix: the translation block's round-off "
                   "bound did not settle; no proof from this factorization";
+  return false;
+}
+
+void CertificateMatrix::InitializeDoubleDouble() {
+  const int size = static_cast<int>(K_.rows());
+  std::vector<int>& position = position_;  // Original index -> pivot order.
+  position.resize(size);
+  for (int k = 0; k < size; ++k) position[ordering_[k]] = k;
+  // The permuted upper triangle: entry (r >= c) of K_ goes to column
+  // max(position) and row min(position).
+  std::vector<int> start(size + 1, 0);
+  const int* outer = K_.outerIndexPtr();
+  const int* inner = K_.innerIndexPtr();
+  for (int c = 0; c < size; ++c) {
+    for (int q = outer[c]; q < outer[c + 1]; ++q) {
+      ++start[std::max(position[inner[q]], position[c]) + 1];
+    }
+  }
+  for (int k = 0; k < size; ++k) start[k + 1] += start[k];
+  std::vector<int> next(start.begin(), start.end() - 1), row(K_.nonZeros());
+  extended_index_.resize(K_.nonZeros());
+  for (int c = 0; c < size; ++c) {
+    for (int q = outer[c]; q < outer[c + 1]; ++q) {
+      const int pr = position[inner[q]], pc = position[c];
+      const int slot = next[std::max(pr, pc)]++;
+      row[slot] = std::min(pr, pc);
+      extended_index_[q] = slot;
+    }
+  }
+  extended_ = std::make_unique<DoubleDoubleCholesky>();
+  extended_->Analyze(size, std::move(start), std::move(row));
+}
+
+bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
+                                          double c) {
+  const auto begin = std::chrono::steady_clock::now();
+  struct Timer {
+    std::chrono::steady_clock::time_point begin;
+    double* total;
+    ~Timer() {
+      *total += std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                              begin)
+                    .count();
+    }
+  } timer{begin, &extended_time_s_};
+  if (!extended_) InitializeDoubleDouble();
+  const int size = static_cast<int>(K_.rows());
+  const int t0 = translation_size_, d = d_;
+  const int* outer = K_.outerIndexPtr();
+  const int* inner = K_.innerIndexPtr();
+  auto index = [&](int row, int col) {  // Value index of K_(row >= col).
+    const int* pos =
+        std::lower_bound(inner + outer[col], inner + outer[col + 1], row);
+    DCHECK(pos != inner + outer[col + 1] && *pos == row);
+    return static_cast<int>(pos - inner);
+  };
+  // K_c from the measurements: the data terms in double-double (products
+  // of two doubles exact, of three within 5u^2, sums within 3.2u^2) and
+  // per-row sums of |terms| with their counts for the assembly's bound.
+  std::vector<DoubleDouble> base(K_.nonZeros());
+  std::vector<double> abs_sum(size, 0.0);
+  std::vector<int> count(size, 0);
+  ForEachDataTerm<DoubleDouble>(
+      problem_.graph(),
+      [&](DataBlock block, int row, int col, const DoubleDouble& value) {
+        const double magnitude = value.AbsUpperBound();
+        switch (block) {
+          case DataBlock::kTranslation: {
+            if (row == 0 || col == 0) return;  // The gauge: t_0 = 0.
+            const int r = row - 1, s = col - 1;
+            abs_sum[r] += magnitude;
+            ++count[r];
+            if (r >= s) base[index(r, s)] += value;
+            return;
+          }
+          case DataBlock::kCoupling: {  // -V at (pose, rotation).
+            if (row == 0) return;
+            const int r = row - 1, s = t0 + col;
+            abs_sum[r] += magnitude;
+            ++count[r];
+            abs_sum[s] += magnitude;
+            ++count[s];
+            base[index(s, r)] -= value;
+            return;
+          }
+          case DataBlock::kRotation:
+          case DataBlock::kRotationSigma: {
+            const int r = t0 + row, s = t0 + col;
+            abs_sum[r] += magnitude;
+            ++count[r];
+            if (r >= s) base[index(r, s)] += value;
+            return;
+          }
+        }
+      });
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const double mu = extended_shift_;
+    std::vector<DoubleDouble> values(K_.nonZeros());
+    std::vector<double> assembly_abs(abs_sum);
+    std::vector<int> assembly_count(count);
+    for (int q = 0; q < K_.nonZeros(); ++q)
+      values[extended_index_[q]] = base[q];
+    for (int j = 0; j < t0; ++j) {
+      DoubleDouble& v = values[extended_index_[translation_diagonal_[j]]];
+      v -= DoubleDouble(mu);
+      assembly_abs[j] += mu;
+      ++assembly_count[j];
+    }
+    int k = 0;
+    for (int i = 0; i < n_; ++i) {
+      for (int b = 0; b < d; ++b) {
+        for (int a = b; a < d; ++a) {
+          DoubleDouble& v = values[extended_index_[block_entry_[k++]]];
+          const double lambda = Lambda(a, d * i + b);
+          v -= DoubleDouble(lambda);
+          if (a == b) v += DoubleDouble(c);
+          const int r = t0 + d * i + a, s = t0 + d * i + b;
+          assembly_abs[r] += std::abs(lambda) + (a == b ? c : 0);
+          assembly_count[r] += 2;
+          if (a != b) {
+            assembly_abs[s] += std::abs(lambda);
+            assembly_count[s] += 2;
+          }
+        }
+      }
+    }
+    ++extended_factorizations_;
+    if (!extended_->Factorize(values)) return false;
+    std::vector<double> rho;
+    extended_->RowBackwardErrorBounds(&rho);
+    double head = 0, tail = 0;
+    for (int i = 0; i < size; ++i) {
+      // Each entry: at most `count` terms, each with two roundings, summed:
+      // within gamma_{count + 3} of the exact value.
+      const double assembly = DoubleDoubleGamma(assembly_count[i] + 3) *
+                              assembly_abs[i] * (1 + 1e-6);
+      const double bound = rho[position_[i]] + assembly;
+      double& side = i < t0 ? head : tail;
+      side = std::max(side, bound);
+    }
+    if (SettleShift(head, &extended_shift_)) {
+      backward_error_ = tail;
+      proven_shift_ = c + tail;
+      extended_shift_ =
+          std::max(1.5 * head, std::numeric_limits<double>::min());
+      VLOG(1) << "K_c proven (double-double): c " << c << " backward error "
+              << tail << " (translation rows " << head << ", shift " << mu
+              << ")";
+      return true;
+    }
+  }
+  LOG(WARNING) << "certificate matrix: the translation block's round-off "
+                  "bound did not settle (double-double)";
   return false;
 }
 

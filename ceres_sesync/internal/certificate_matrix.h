@@ -9,38 +9,62 @@
 //         [ -Vbar^T   D - Lambda + cI ]
 //
 // so S + cI is positive definite if and only if K_c is, and a sparse Cholesky
-// factorization of K_c that succeeds proves lambda_min(S) > -c (up to the
-// floating-point backward error of the factorization, which Factorize()
-// accounts for: see proven_shift()). The same factorization applies
-// (S + cI)^{-1}, which the shift-and-invert eigensolver uses.
+// factorization of K_c proves lambda_min(S) > -c, up to round-off, which
+// Prove() accounts for completely (see there). The same factorization (in
+// double) applies (S + cI)^{-1}, which the shift-and-invert eigensolver uses.
 
 #ifndef CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 #define CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 
+#include <memory>
 #include <vector>
 
 #include "ceres_sesync/internal/sesync_problem.h"
 
 namespace ceres_sesync::internal {
 
+class DoubleDoubleCholesky;
+
+// The arithmetic of a proof's factorization.
+enum class ProofPrecision {
+  kDouble,        // CHOLMOD in double: fast; resolves ~1e-16 of K's scale.
+  kDoubleDouble,  // extended_cholesky.h: ~1e-31 of K's scale, 3-7x slower.
+};
+const char* ProofPrecisionName(ProofPrecision precision);
+
 class CertificateMatrix {
  public:
-  // `strict_round_off`: see proven_shift().
-  explicit CertificateMatrix(const SESyncProblem& problem,
-                             bool strict_round_off = false);
+  // `problem` must outlive this object.
+  explicit CertificateMatrix(const SESyncProblem& problem);
+  ~CertificateMatrix();
 
-  // Assembles and factorizes K_c for the d x dn multipliers Lambda. Returns
-  // true iff the Cholesky factorization ran to completion. Without
-  // `bound_backward_error` (for preconditioning, not proofs) proven_shift()
-  // is not computed.
-  bool Factorize(const Eigen::MatrixXd& Lambda, double c,
-                 bool bound_backward_error = true);
+  // Factorizes K_c in double for solves (the preconditioner, the
+  // eigensolver): no proof. Returns true iff the factorization completed.
+  bool Factorize(const Eigen::MatrixXd& Lambda, double c);
 
-  // After a successful Factorize(): x = (S_mu + cI)^{-1} y, y and x in R^{dn},
-  // where S_mu = D - Lambda - Vbar^T (Lbar - mu I)^{-1} Vbar, mu =
-  // translation_shift() (0 after Factorize without bound_backward_error):
-  // S_mu <= S, within mu ||Lbar^{-1} Vbar||^2 of it (for eigenvalue
-  // estimates, not proofs).
+  // Tries to prove S + eta I positive semidefinite for eta = c + delta with a
+  // small delta, accounting for all round-off. Returns true iff it did;
+  // proven_shift() is then eta.
+  //
+  // The matrix factorized is K' = K_c - diag(mu I, 0), K_c assembled from
+  // the measurements' exact values and mu > 0 a shift of the translation
+  // block. A completed factorization L L^T = K'~ + E of the assembled K'~
+  // bounds, row by row, the factorization's backward error E
+  // (CholmodFactor::RowBackwardErrorBounds or DoubleDoubleCholesky's, both
+  // gamma_{k+1} |L||L^T|) and the assembly's rounding A = K'~ - K':
+  // K' + diag(rho) >= 0 with rho_i >= sum_j |E_ij| + |A_ij|. If rho_i <= mu on
+  // every translation row, then K_c + diag(0, delta I) >= 0 with delta the
+  // largest rho_i on the rotation rows, and its Schur complement gives
+  // S + (c + delta) I >= 0: a complete proof, with no first-order step. mu is
+  // adapted (per precision) until it covers the translation rows; it costs
+  // about mu x (mean squared distance of the poses from pose 0) in lambda_min,
+  // which is why large maps need double-double: its mu is ~1e15 times
+  // smaller. A double proof leaves its factor for SolveShifted() (of
+  // S_mu + cI, S_mu = S - mu Vbar^T Lbar^-2 Vbar to first order).
+  bool Prove(const Eigen::MatrixXd& Lambda, double c, ProofPrecision precision);
+
+  // After a successful Factorize() or double Prove(): x = (S_mu + cI)^{-1} y,
+  // y and x in R^{dn}, with mu = translation_shift() (0 after Factorize()).
   void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;
   // The same for the columns of Y (dn x k).
   void SolveShifted(const Eigen::MatrixXd& Y, Eigen::MatrixXd* X) const;
@@ -50,27 +74,17 @@ class CertificateMatrix {
   SparseCholeskyFactor ExtractFactor() { return factor_.ExtractFactor(); }
   int translation_size() const { return translation_size_; }
 
-  // After a successful Factorize(Lambda, c): c + delta, with delta a bound
-  // on the factorization's floating-point backward error, computed row by
-  // row (CholmodFactor::BackwardErrorBound, plus the rounding of the
-  // assembly) and split into the translation rows (h) and the rotation rows.
-  //  - Default: delta = max over all rows. K_c + delta I is then proven
-  //    positive semidefinite; S + delta I follows to first order only:
-  //    round-off h in the translation block reaches S amplified by up to
-  //    ||Lbar^{-1} Vbar||^2, and that amplification is not added.
-  //  - strict_round_off: the factorized matrix is K_c with its translation
-  //    block shifted down to Lbar - mu I, mu >= h (adapted until it is), and
-  //    delta covers the rotation rows only. Then K_c + diag(0, delta I) is
-  //    proven positive semidefinite, hence its Schur complement
-  //    S + (c + delta) I, rigorously. The price: S_mu = S - (about)
-  //    mu Vbar^T Lbar^{-2} Vbar is what must be positive semidefinite, which
-  //    costs roughly mu * (mean squared distance of the poses from pose 0)
-  //    in lambda_min: large maps need much larger shifts.
+  // After a successful Prove(): eta = c + delta, delta and mu.
   double proven_shift() const { return proven_shift_; }
   double backward_error() const { return backward_error_; }
-  // mu of the last factorization with bound_backward_error (see
-  // proven_shift()), else 0.
+  // mu of the current double factor (0 after Factorize()).
   double translation_shift() const { return factorized_shift_; }
+
+  // Factorizations so far, by arithmetic, and the seconds spent in the
+  // double-double ones (including their assembly and symbolic analysis).
+  int double_factorizations() const { return double_factorizations_; }
+  int extended_factorizations() const { return extended_factorizations_; }
+  double extended_time_s() const { return extended_time_s_; }
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }
@@ -79,24 +93,39 @@ class CertificateMatrix {
   bool supernodal() const { return factor_.IsSupernodal(); }
 
  private:
-  // K_ = K_c with Lambda, c and the translation block Lbar - mu I; sets
-  // *rotation_rounding to a bound on the rounding of the rotation rows.
+  // K_ = K_c with Lambda, c and the translation block Lbar - mu I; returns
+  // per-row bounds on the rounding of this assembly.
   void Assemble(const Eigen::MatrixXd& Lambda, double c, double mu,
-                double* rotation_rounding);
+                std::vector<double>* rounding);
+  bool ProveDouble(const Eigen::MatrixXd& Lambda, double c);
+  bool ProveDoubleDouble(const Eigen::MatrixXd& Lambda, double c);
+  // The permuted pattern and symbolic analysis of the double-double factor.
+  void InitializeDoubleDouble();
+  // mu settled when the translation rows' bound `head` met it or not.
+  bool SettleShift(double head, double* mu) const;
 
-  bool strict_round_off_ = false;
+  const SESyncProblem& problem_;
   int d_ = 0, n_ = 0, translation_size_ = 0, rotation_size_ = 0;
-  SparseMatrix K_;                   // Lower triangle, pattern fixed.
-  std::vector<double> base_values_;  // K_0 without Lambda.
-  std::vector<int> block_entry_;     // Value index of each (i, a >= b).
-  CholmodFactor factor_;
+  SparseMatrix K_;                         // Lower triangle, pattern fixed.
+  std::vector<double> base_values_;        // K_0 without Lambda.
+  std::vector<int> block_entry_;           // Value index of each (i, a >= b).
   std::vector<int> translation_diagonal_;  // Value index of each Lbar_jj.
-  double max_translation_diagonal_ = 0;
-  // mu: the translation block of the factorized matrix is Lbar - mu I.
-  double translation_shift_ = 0;
-  double factorized_shift_ = 0;  // The mu of the current factor.
+  std::vector<int> ordering_;  // Fill-reducing: ordering_[k] = k-th pivot.
+  std::vector<int> position_;  // Its inverse (after InitializeDoubleDouble).
+  // Rounding of the stored data matrices, per row of K.
+  std::vector<double> data_rounding_;
+  CholmodFactor factor_;
+  double factorized_shift_ = 0;  // mu of the current double factor.
+  // mu per precision: the translation block of a proof's matrix is Lbar - mu I.
+  double double_shift_ = 0, extended_shift_ = 0;
   double proven_shift_ = 0;
   double backward_error_ = 0;
+  int double_factorizations_ = 0, extended_factorizations_ = 0;
+  double extended_time_s_ = 0;
+  // Double-double: the factorization, the map from K_'s value indices to its
+  // permuted upper-triangle values, and those values.
+  std::unique_ptr<DoubleDoubleCholesky> extended_;
+  std::vector<int> extended_index_;
 };
 
 }  // namespace ceres_sesync::internal

@@ -44,8 +44,7 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
       own = std::make_unique<CertificateMatrix>(problem);
       workspace = own.get();
     }
-    CHECK(workspace->Factorize(Eigen::MatrixXd::Zero(d, d * n), eps,
-                               /*bound_backward_error=*/false))
+    CHECK(workspace->Factorize(Eigen::MatrixXd::Zero(d, d * n), eps))
         << "regularized Q preconditioner: factorization failed";
     factor_ = workspace->ExtractFactor();
     translation_size_ = workspace->translation_size();

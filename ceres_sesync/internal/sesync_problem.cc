@@ -11,6 +11,7 @@
 namespace ceres_sesync::internal {
 
 using Triplet = Eigen::Triplet<double>;
+constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
 
 namespace {
 
@@ -113,8 +114,7 @@ void ForEachFactorEntry(const cholmod_factor& L, Visit visit) {
 
 }  // namespace
 
-void CholmodFactor::BackwardErrorBound(int split, double* head_bound,
-                                       double* tail_bound) {
+void CholmodFactor::RowBackwardErrorBounds(std::vector<double>* rho) {
   CHECK(m_cholmodFactor != nullptr && m_factorizationIsOk);
   const cholmod_factor& L = *m_cholmodFactor;
   CHECK(L.is_ll) << "the backward error bound is for LL^T factors";
@@ -130,14 +130,26 @@ void CholmodFactor::BackwardErrorBound(int split, double* head_bound,
   });
   // Entry (i, j) of L L^T sums at most min(k_i, k_j) products (k_i = stored
   // entries in row i), so row i of the error is bounded by gamma_{k_i + 1} v_i.
+  // The factor (1 + 1e-6) covers the rounding of computing v (sums of up to
+  // 10^9 nonnegative terms, each within gamma_{10^9} < 1.2e-7).
   const double unit_roundoff = std::numeric_limits<double>::epsilon() / 2;
   const int* perm = static_cast<const int*>(L.Perm);
-  *head_bound = *tail_bound = 0;
+  rho->assign(n, 0.0);
   for (int i = 0; i < n; ++i) {
     const double m = row_count[i] + 1;
-    const double bound = m * unit_roundoff / (1 - m * unit_roundoff) * v[i];
-    double& side = (perm ? perm[i] : i) < split ? *head_bound : *tail_bound;
-    side = std::max(side, bound);
+    (*rho)[perm ? perm[i] : i] =
+        m * unit_roundoff / (1 - m * unit_roundoff) * v[i] * (1 + 1e-6);
+  }
+}
+
+void CholmodFactor::BackwardErrorBound(int split, double* head_bound,
+                                       double* tail_bound) {
+  std::vector<double> rho;
+  RowBackwardErrorBounds(&rho);
+  *head_bound = *tail_bound = 0;
+  for (int i = 0; i < static_cast<int>(rho.size()); ++i) {
+    double& side = i < split ? *head_bound : *tail_bound;
+    side = std::max(side, rho[i]);
   }
 }
 
@@ -194,7 +206,8 @@ void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
 }
 
 SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
-    : d_(graph.dimension),
+    : graph_(&graph),
+      d_(graph.dimension),
       n_(graph.num_poses),
       num_threads_(std::max(1, num_threads)) {
   const int d = d_, n = n_;
@@ -204,24 +217,52 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   sigma.reserve(m * d * d);
   v.reserve(2 * m * d);
   lw.reserve(4 * m);
-  for (const RelativePoseMeasurement& e : graph.measurements) {
-    const int i = e.i, j = e.j;
-    for (int a = 0; a < d; ++a) {
-      lrho.emplace_back(d * i + a, d * i + a, e.kappa);
-      lrho.emplace_back(d * j + a, d * j + a, e.kappa);
-      for (int b = 0; b < d; ++b) {
-        lrho.emplace_back(d * i + a, d * j + b, -e.kappa * e.R(a, b));
-        lrho.emplace_back(d * j + b, d * i + a, -e.kappa * e.R(a, b));
-        sigma.emplace_back(d * i + a, d * i + b, e.tau * e.t(a) * e.t(b));
-      }
-      // V = A Omega B^T: +tau t~^T at (j, block i), -tau t~^T at (i, block i).
-      v.emplace_back(j, d * i + a, e.tau * e.t(a));
-      v.emplace_back(i, d * i + a, -e.tau * e.t(a));
-    }
-    lw.emplace_back(i, i, e.tau);
-    lw.emplace_back(j, j, e.tau);
-    lw.emplace_back(std::max(i, j), std::min(i, j), -e.tau);
-  }
+  // Per row of M: the sum of |terms| and their number, for the rounding
+  // bounds. Rows of D carry the terms of L(G^rho) and Sigma~ plus one more
+  // rounding (their sum).
+  std::vector<double> t_abs(n, 0.0), r_abs(d * n, 0.0);
+  std::vector<int> t_count(n, 0), r_count(d * n, 0);
+  ForEachDataTerm<double>(
+      graph, [&](DataBlock block, int row, int col, double value) {
+        switch (block) {
+          case DataBlock::kTranslation:
+            lw.emplace_back(row, col, value);
+            t_abs[row] += std::abs(value);
+            ++t_count[row];
+            return;
+          case DataBlock::kCoupling:  // M has -V at (row, col) and (col, row).
+            v.emplace_back(row, col, value);
+            t_abs[row] += std::abs(value);
+            ++t_count[row];
+            r_abs[col] += std::abs(value);
+            ++r_count[col];
+            return;
+          case DataBlock::kRotation:
+            lrho.emplace_back(row, col, value);
+            break;
+          case DataBlock::kRotationSigma:
+            sigma.emplace_back(row, col, value);
+            break;
+        }
+        r_abs[row] += std::abs(value);
+        ++r_count[row];
+      });
+  // Each stored entry is a sum of at most k rounded terms (a product of up
+  // to three doubles: two roundings each) plus one rounding of the sum
+  // L(G^rho) + Sigma~: within gamma_{k+3} of its exact value, k bounded by
+  // the row's terms. The factor (1 + 1e-6) covers this computation's own
+  // rounding.
+  auto bound = [](int count, double abs_sum) {
+    const double g =
+        (count + 3) * kUnitRoundoff / (1 - (count + 3) * kUnitRoundoff);
+    return g * abs_sum * (1 + 1e-6);
+  };
+  translation_row_rounding_.resize(n);
+  for (int i = 0; i < n; ++i)
+    translation_row_rounding_[i] = bound(t_count[i], t_abs[i]);
+  rotation_row_rounding_.resize(d * n);
+  for (int i = 0; i < d * n; ++i)
+    rotation_row_rounding_[i] = bound(r_count[i], r_abs[i]);
   Lrho_.resize(d * n, d * n);
   Lrho_.setFromTriplets(lrho.begin(), lrho.end());
   SparseMatrix sigma_matrix(d * n, d * n);

@@ -45,6 +45,9 @@ class CholmodFactor
   // -E <= diag(rho) for rho_i = sum_j |E_ij| (symmetric E, Gershgorin-type:
   // 2 |x_i x_j| <= x_i^2 + x_j^2). O(nnz(L)), on the factor in place.
   void BackwardErrorBound(int split, double* head_bound, double* tail_bound);
+  // The same bound row by row: rho[i] >= sum_j |E_ij| for every original
+  // index i.
+  void RowBackwardErrorBounds(std::vector<double>* rho);
   // After a successful factorization: a copy of the factor for fast solves
   // with r x N right-hand sides.
   SparseCholeskyFactor ExtractFactor();
@@ -77,12 +80,57 @@ constexpr double kSupernodalSwitch = 200;
 // printing (failures are reported through info()).
 void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor);
 
+// The data matrix M of the objective as a sum of terms, one
+// visit(block, row, column, value) per term, with values computed in
+// `Scalar` from the measurements (double, or DoubleDouble for the
+// high-precision certificate). Blocks and their indices:
+//   kTranslation:   L(W^tau), poses (row, column);
+//   kCoupling:      V, pose row, rotation column d*i + a;
+//   kRotation:      L(G^rho), rotation indices;
+//   kRotationSigma: Sigma~, rotation indices (D = L(G^rho) + Sigma~).
+// The symmetric blocks get both (row, column) and (column, row) of every
+// off-diagonal term. Within a block, entries are the sums of their terms in
+// visiting order (so assembling from these terms reproduces SESyncProblem's
+// matrices bitwise).
+enum class DataBlock { kTranslation, kCoupling, kRotation, kRotationSigma };
+
+template <typename Scalar, typename Visit>
+void ForEachDataTerm(const PoseGraph& graph, Visit&& visit) {
+  const int d = graph.dimension;
+  for (const RelativePoseMeasurement& e : graph.measurements) {
+    const int i = e.i, j = e.j;
+    const Scalar kappa(e.kappa), tau(e.tau);
+    for (int a = 0; a < d; ++a) {
+      visit(DataBlock::kRotation, d * i + a, d * i + a, kappa);
+      visit(DataBlock::kRotation, d * j + a, d * j + a, kappa);
+      for (int b = 0; b < d; ++b) {
+        const Scalar r = -kappa * Scalar(e.R(a, b));
+        visit(DataBlock::kRotation, d * i + a, d * j + b, r);
+        visit(DataBlock::kRotation, d * j + b, d * i + a, r);
+        visit(DataBlock::kRotationSigma, d * i + a, d * i + b,
+              tau * Scalar(e.t(a)) * Scalar(e.t(b)));
+      }
+      // V = A Omega B^T: +tau t~^T at (j, block i), -tau t~^T at (i, block i).
+      const Scalar v = tau * Scalar(e.t(a));
+      visit(DataBlock::kCoupling, j, d * i + a, v);
+      visit(DataBlock::kCoupling, i, d * i + a, -v);
+    }
+    visit(DataBlock::kTranslation, i, i, tau);
+    visit(DataBlock::kTranslation, j, j, tau);
+    visit(DataBlock::kTranslation, i, j, -tau);
+    visit(DataBlock::kTranslation, j, i, -tau);
+  }
+}
+
 class SESyncProblem {
  public:
-  // `graph` must pass ValidatePoseGraph. Check ok() afterwards: it fails only
-  // if the translational Laplacian could not be factorized. Products with Q
-  // use up to `num_threads` threads (results do not depend on it).
+  // `graph` must pass ValidatePoseGraph and outlive this object. Check ok()
+  // afterwards: it fails only if the translational Laplacian could not be
+  // factorized. Products with Q use up to `num_threads` threads (results do
+  // not depend on it).
   explicit SESyncProblem(const PoseGraph& graph, int num_threads = 1);
+
+  const PoseGraph& graph() const { return *graph_; }
 
   bool ok() const { return ok_; }
   int dimension() const { return d_; }
@@ -100,7 +148,7 @@ class SESyncProblem {
   const SparseMatrix& D() const { return D_; }
   // Vbar: V without its first row ((n-1) x dn).
   const SparseMatrix& Vbar() const { return Vbar_; }
-  // Lbar: L(W^tau) without its first row and column (lower triangle stored).
+  // Lbar: L(W^tau) without its first row and column (both triangles stored).
   const SparseMatrix& Lbar() const { return Lbar_; }
   // The rotational connection Laplacian L(G^rho) alone (dn x dn).
   const SparseMatrix& RotationLaplacian() const { return Lrho_; }
@@ -113,8 +161,22 @@ class SESyncProblem {
   // call.
   double LbarBackwardError() const;
 
+  // Bounds on the rounding of the matrices as stored against their exact
+  // values from the measurements (ForEachDataTerm), per row of
+  // M = [L(W^tau) -V; -V^T D]: sum_j |stored M_ij - exact M_ij| over the row
+  // (gamma_{k+1} times the sum of the row's |terms|, k its number of terms).
+  // Translation rows by pose (size n), rotation rows (size dn).
+  const std::vector<double>& translation_row_rounding() const {
+    return translation_row_rounding_;
+  }
+  const std::vector<double>& rotation_row_rounding() const {
+    return rotation_row_rounding_;
+  }
+
  private:
+  const PoseGraph* graph_ = nullptr;
   int d_ = 0, n_ = 0, num_threads_ = 1;
+  std::vector<double> translation_row_rounding_, rotation_row_rounding_;
   bool ok_ = false;
   SparseMatrix D_, Lrho_, Vbar_, VbarT_, minus_Vbar_, Lbar_;
   std::unique_ptr<CholmodFactor> lbar_factor_;

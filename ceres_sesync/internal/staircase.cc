@@ -1,6 +1,7 @@
 #include "ceres_sesync/internal/staircase.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 
@@ -75,7 +76,6 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   s.dimension = graph.dimension;
   s.num_poses = graph.num_poses;
   s.num_measurements = static_cast<int>(graph.measurements.size());
-  s.strict_round_off = options.strict_round_off;
   if (!ValidatePoseGraph(graph, &s.message)) {
     s.status = SolverSummary::Status::kInvalidInput;
     return;
@@ -90,6 +90,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   }
   if (n_ == 1) {  // Nothing to estimate: the pose is the gauge.
     s.status = SolverSummary::Status::kCertifiedOptimum;
+    s.relaxation_exact = true;
     s.final_rank = d_;
     s.total_time_s = Elapsed();
     ok_ = trivial_ = true;
@@ -105,8 +106,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     s.message = "the translational Laplacian is not positive definite";
     return;
   }
-  certificate_ =
-      std::make_unique<CertificateMatrix>(*problem_, options.strict_round_off);
+  certificate_ = std::make_unique<CertificateMatrix>(*problem_);
   preconditioner_ = std::make_unique<SESyncPreconditioner>(
       *problem_, ToInternal(options.preconditioner),
       options.regularized_cholesky_max_condition, certificate_.get());
@@ -251,14 +251,29 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
 VerificationResult Staircase::Verify(double sdp_value) {
   const int d = d_, n = n_;
   const double eta_floor = options_.min_relative_eta * scale_;
-  const double eta_target =
-      std::max(eta_floor, options_.certification_target_relative_bound *
-                              sdp_value / (d * n));
-  const double eta_max =
-      std::max(eta_floor,
-               options_.certification_max_relative_bound * sdp_value / (d * n));
+  auto shift = [&](double relative_bound) {
+    return std::max(eta_floor, relative_bound * sdp_value / (d * n));
+  };
+  VerificationOptions verification_options;
+  verification_options.eta_target =
+      shift(options_.certification_target_relative_bound);
+  verification_options.eta_max =
+      shift(options_.certification_max_relative_bound);
+  verification_options.eta_goal =
+      shift(options_.certification_goal_relative_bound);
+  switch (options_.proof_arithmetic) {
+    case SolverOptions::ProofArithmetic::kAutomatic:
+      verification_options.policy = ProofPolicy::kAutomatic;
+      break;
+    case SolverOptions::ProofArithmetic::kDouble:
+      verification_options.policy = ProofPolicy::kDouble;
+      break;
+    case SolverOptions::ProofArithmetic::kDoubleDouble:
+      verification_options.policy = ProofPolicy::kDoubleDouble;
+      break;
+  }
   VerificationResult verification = VerifyCertificate(
-      *problem_, cost_->Lambda(), eta_target, eta_max, certificate_.get());
+      *problem_, cost_->Lambda(), verification_options, certificate_.get());
   if (!verification.certified && sdp_value <= zero_objective_) {
     // F >= 0 always: a (numerically) zero value is optimal as it stands.
     verification.certified = true;
@@ -308,7 +323,17 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
     level.certified = verification_.certified;
     level.eta = verification_.eta;
     level.lambda_min_estimate = verification_.lambda_min_estimate;
+    level.factorizations = verification_.factorizations;
+    level.extended_factorizations = verification_.extended_factorizations;
+    // The dual bound of these multipliers (they change when rounding
+    // refines the poses).
+    lower_bound_ =
+        std::isfinite(verification_.eta)
+            ? ProvenLowerBound(cost_->Lambda(), d_, verification_.eta)
+            : 0.0;
     s.factorizations += verification_.factorizations;
+    s.extended_factorizations += verification_.extended_factorizations;
+    s.extended_proof_time_s += verification_.extended_time_s;
     s.iterations += level.iterations;
     s.hessian_vector_products += level.hessian_vector_products;
     s.optimization_time_s += level.optimize_time_s;
@@ -326,7 +351,11 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
       return;
     }
     if (verification_.eigensolver_failed) {
-      s.status = SolverSummary::Status::kEigenImprecision;
+      // No negative curvature to climb along: either a bound was proven but
+      // it is above the tolerance, or not even that.
+      s.status = std::isfinite(verification_.eta)
+                     ? SolverSummary::Status::kBoundAboveTolerance
+                     : SolverSummary::Status::kEigenImprecision;
       return;
     }
     if (options_.max_time_s > 0 && Elapsed() >= options_.max_time_s) {
@@ -377,17 +406,17 @@ Poses Staircase::Round(const Eigen::MatrixXd& Y) {
 
 void Staircase::Report(const Poses& poses) {
   SolverSummary& s = *summary_;
-  const int d = d_, n = n_;
   s.sdp_value = sdp_value_;
   s.objective = EvaluateObjective(graph_, poses);
   s.eta = verification_.eta;
   s.lambda_min_estimate = verification_.lambda_min_estimate;
+  s.proof_precision = std::isfinite(s.eta)
+                          ? ProofPrecisionName(verification_.precision)
+                          : "none";
   s.rounding_gap = (s.objective - sdp_value_) / std::max(sdp_value_, 1e-300);
   // tr(Lambda) - eta d n bounds the optimum whenever S + eta I was proven
-  // PSD, certified or not.
-  s.lower_bound = std::isfinite(s.eta)
-                      ? std::max(0.0, sdp_value_ - s.eta * d * n)
-                      : 0.0;  // F >= 0 always.
+  // PSD, certified or not; F >= 0 always.
+  s.lower_bound = std::max(0.0, lower_bound_);
   // The attained objective bounds the optimum too (guards F(Y) round-off).
   s.lower_bound = std::min(s.lower_bound, s.objective);
   s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
@@ -396,14 +425,25 @@ void Staircase::Report(const Poses& poses) {
       : s.objective <= zero_objective_
           ? 0
           : std::numeric_limits<double>::infinity();
+  s.relaxation_exact =
+      verification_.certified &&
+      (s.rounding_gap <= options_.certification_max_rounding_gap ||
+       s.objective <= zero_objective_);
   if (s.status == SolverSummary::Status::kCertifiedOptimum &&
       !(s.relative_suboptimality_bound <=
-            options_.certification_max_relative_bound &&
-        (s.rounding_gap <= options_.certification_max_rounding_gap ||
-         s.objective <= zero_objective_))) {
+        options_.certification_max_relative_bound)) {
     // Y is optimal for the SDP, but the rounded poses are not provably
-    // optimal: the relaxation is not exact on this problem.
-    s.status = SolverSummary::Status::kRelaxationNotExact;
+    // within the tolerance (the relaxation is not exact here).
+    s.status = SolverSummary::Status::kBoundAboveTolerance;
+  }
+  if (s.status == SolverSummary::Status::kBoundAboveTolerance) {
+    char message[160];
+    std::snprintf(message, sizeof(message),
+                  "the proven relative suboptimality bound %.3e is above the "
+                  "tolerance %.3e",
+                  s.relative_suboptimality_bound,
+                  options_.certification_max_relative_bound);
+    s.message = message;
   }
   s.total_time_s = Elapsed();
   Progress("done", s.final_rank, s.iterations, s.objective);

@@ -114,6 +114,7 @@ class Staircase {
   std::unique_ptr<SESyncCost> cost_;
   VerificationResult verification_;
   double sdp_value_ = 0;
+  double lower_bound_ = 0;  // Proven at the last verification.
 };
 
 // Poses from rotations R (d x dn) and translations T (d x n), expressed in the

@@ -5,6 +5,7 @@
 
 #include "Eigen/Eigenvalues"
 #include "Spectra/SymEigsSolver.h"
+#include "ceres_sesync/internal/double_double.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
@@ -88,6 +89,24 @@ double MaxBlockEigenvalue(const Eigen::MatrixXd& Lambda, int d) {
 
 }  // namespace
 
+double ProvenLowerBound(const Eigen::MatrixXd& Lambda, int d, double eta) {
+  // Sum in double-double: within gamma_k (double-double) of the exact sum,
+  // k = dn terms; eta * dn exactly (TwoProduct); one more subtraction.
+  DoubleDouble trace;
+  double abs_trace = 0;
+  const int dn = static_cast<int>(Lambda.cols());
+  for (int i = 0; i < dn; ++i) {
+    trace += DoubleDouble(Lambda(i % d, i));
+    abs_trace += std::abs(Lambda(i % d, i));
+  }
+  const DoubleDouble shift = dd::TwoProduct(eta, static_cast<double>(dn));
+  const DoubleDouble bound = trace - shift;
+  const double error = DoubleDoubleGamma(dn + 2) *
+                           (abs_trace + shift.AbsUpperBound()) * (1 + 1e-6) +
+                       4 * kUnitRoundoffDouble * bound.AbsUpperBound();
+  return bound.ToDouble() - error;
+}
+
 Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
                                     const Eigen::MatrixXd& Lambda,
                                     const Eigen::VectorXd& v) {
@@ -101,117 +120,183 @@ Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
 
 VerificationResult VerifyCertificate(const SESyncProblem& problem,
                                      const Eigen::MatrixXd& Lambda,
-                                     double eta_target, double eta_max,
+                                     const VerificationOptions& options,
                                      CertificateMatrix* matrix) {
   VerificationResult result;
   result.lambda_min_estimate = std::numeric_limits<double>::quiet_NaN();
+  result.eta = std::numeric_limits<double>::infinity();
   const int d = problem.dimension();
-  ++result.factorizations;
-  if (matrix->Factorize(Lambda, eta_target) &&
-      matrix->proven_shift() <= eta_max) {
-    result.certified = true;
-    result.eta = matrix->proven_shift();
+  const int double_before = matrix->double_factorizations();
+  const int extended_before = matrix->extended_factorizations();
+  const double extended_time_before = matrix->extended_time_s();
+  const double eta_target = options.eta_target, eta_max = options.eta_max;
+  const double goal = options.eta_goal > 0 ? options.eta_goal : eta_max;
+  const bool use_extended = options.policy != ProofPolicy::kDouble;
+  const ProofPrecision first = options.policy == ProofPolicy::kDoubleDouble
+                                   ? ProofPrecision::kDoubleDouble
+                                   : ProofPrecision::kDouble;
+  auto finish = [&]() {
+    result.certified = result.eta <= eta_max;
+    result.factorizations = matrix->double_factorizations() - double_before;
+    result.extended_factorizations =
+        matrix->extended_factorizations() - extended_before;
+    result.extended_time_s = matrix->extended_time_s() - extended_time_before;
+    if (!result.certified && (result.direction.size() != matrix->dimension() ||
+                              !(result.direction_curvature < 0))) {
+      result.eigensolver_failed = true;
+    }
     return result;
+  };
+  auto prove = [&](double c, ProofPrecision precision) {
+    if (!matrix->Prove(Lambda, c, precision)) return false;
+    if (matrix->proven_shift() < result.eta) {
+      result.eta = matrix->proven_shift();
+      result.precision = precision;
+    }
+    return true;
+  };
+  // Double-double proofs at shifts from the goal down to the tolerance; the
+  // first success ends them (each costs 3-7 double factorizations).
+  auto prove_extended = [&]() {
+    double tried = 0;
+    for (double c : {goal / 16, goal, eta_max}) {
+      c = std::max(c, eta_target);
+      if (c >= result.eta) break;  // Could not improve on what is proven.
+      if (c <= tried) continue;
+      tried = c;
+      if (prove(c, ProofPrecision::kDoubleDouble)) break;
+    }
+  };
+
+  // 1. The fast path: a proof at the target shift, then in double one at a
+  // quarter of the goal (where double suffices, e.g. compact 3D maps, that
+  // is all it takes).
+  if (prove(eta_target, first) && result.eta <= goal) return finish();
+  if (first == ProofPrecision::kDouble && goal / 4 > eta_target &&
+      prove(goal / 4, ProofPrecision::kDouble) && result.eta <= goal) {
+    return finish();
   }
-  // Bracket lambda_min(S) from below: S + cI is PD for c > lambda_max(Lambda).
+
+  // 2. Near-optimal (lambda_min(S) > -eta_max up to round-off) or not?
+  bool near_optimal = result.eta <= eta_max;
+  if (!near_optimal && eta_max > eta_target) {
+    near_optimal = matrix->Factorize(Lambda, eta_max);
+  }
+  // 3. Near-optimal: tighten the proof.
+  if (near_optimal) {
+    if (use_extended) {
+      prove_extended();
+    } else {
+      // Double only: the strict proofs need shifts above what the
+      // translation shift mu costs; start just above the estimate of
+      // lambda_min(S) from the factor at eta_max and step up by 8.
+      double start = std::max(eta_target, std::numeric_limits<double>::min());
+      if (result.eta > eta_max) {  // The current factor is that at eta_max.
+        ShiftInvertOperator op(matrix);
+        const int dim = matrix->dimension();
+        Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1,
+                                                         std::min(20, dim));
+        eigs.init();
+        eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-8);
+        if (eigs.info() == Spectra::CompInfo::Successful) {
+          result.lambda_min_estimate = 1.0 / eigs.eigenvalues()(0) - eta_max;
+          start = std::max(start, -1.1 * result.lambda_min_estimate);
+        }
+      }
+      for (double c = start; c < result.eta; c = std::min(8 * c, eta_max)) {
+        if (prove(c, ProofPrecision::kDouble) || c >= eta_max) break;
+      }
+    }
+    if (result.eta <= eta_max) return finish();
+  }
+
+  // 4. A witness of negative curvature. Bracket lambda_min(S) from below:
+  // S + cI is PD for c > lambda_max(Lambda).
   double c_upper = 1.01 * MaxBlockEigenvalue(Lambda, d) + eta_target;
-  double c = eta_target;
-  bool proven = false;
+  double c = std::max(eta_target, eta_max);
   // Poor candidate? With c_vacuous = tr(Lambda) / dn every proven shift
   // c >= c_vacuous gives the bound tr(Lambda) - c d n <= 0. One factorization
   // at c_vacuous tells: if it fails, so would every smaller shift, so no
   // bound worth proving exists: the witness comes from Lanczos on S if that
   // converges (cubicle's file guess 0.45 -> 0.19 s, torus3D 0.24 -> 0.13 s),
-  // else the bracketing starts at c_vacuous instead of eta_target (skipping
-  // up to ten factorizations that fail late). If it succeeds, the
-  // bracketing stops there at the latest.
+  // else the ladder starts at c_vacuous (skipping up to ten factorizations
+  // that fail late). If it succeeds, the ladder stops there at the latest.
   const double c_vacuous = BlockDiagonalTrace(Lambda, d) / Lambda.cols();
-  if (c_vacuous > std::max(eta_target, eta_max) && c_vacuous < c_upper) {
-    ++result.factorizations;
-    if (matrix->Factorize(Lambda, c_vacuous)) {
+  double factor_shift = 0;  // The smallest shift proven here.
+  bool proven = false;
+  bool factor_is_current = false;  // The double factor is that at factor_shift.
+  if (c_vacuous > c && c_vacuous < c_upper) {
+    if (prove(c_vacuous, ProofPrecision::kDouble)) {
       c_upper = c_vacuous;
+      proven = factor_is_current = true;
+      factor_shift = c_vacuous;
     } else {
       result.vacuous_bound = true;
-      if (FindNegativeCurvature(problem, Lambda, &result)) {
-        result.eta = std::numeric_limits<double>::infinity();
-        return result;
-      }
+      if (FindNegativeCurvature(problem, Lambda, &result)) return finish();
       c = c_vacuous;
     }
   }
   for (int step = 0; c < c_upper; ++step) {
     if (step == 2 && matrix->supernodal() && !result.vacuous_bound) {
-      // lambda_min(S) < -256 eta_target: usually clear negative curvature
-      // (a saddle or a poor candidate), which Lanczos on S finds in a few
-      // dozen products with Q; jump the shift just past it. Only worth it
-      // when factorizations are expensive (supernodal: heavy fill, e.g.
-      // torus3D); sparser factorizations are cheaper than the Lanczos run.
-      // (Not again after the poor-candidate test: it already ran, and failed.)
+      // lambda_min(S) < -256 max(eta_target, eta_max): usually clear
+      // negative curvature (a saddle or a poor candidate), which Lanczos on
+      // S finds in a few dozen products with Q; jump the shift just past
+      // it. Only worth it when factorizations are expensive (supernodal:
+      // heavy fill, e.g. torus3D); sparser factorizations are cheaper than
+      // the Lanczos run. (Not again after the poor-candidate test: it
+      // already ran, and failed.)
       if (FindNegativeCurvature(problem, Lambda, &result)) {
         c = std::max(c,
                      std::min(-1.1 * result.direction_curvature, c_upper) / 16);
       }
     }
-    c = std::min(16 * c, c_upper);
-    ++result.factorizations;
-    if (matrix->Factorize(Lambda, c)) {
+    c = std::min(16 * std::max(c, std::numeric_limits<double>::min()), c_upper);
+    if (proven && c >= factor_shift) break;  // c_vacuous is proven already.
+    factor_is_current = prove(c, ProofPrecision::kDouble);
+    if (factor_is_current) {
       proven = true;
+      factor_shift = c;
       break;
     }
   }
-  if (!proven) {
-    // Only round-off can make this fail; report it as an eigen failure.
-    result.eta = std::numeric_limits<double>::infinity();
-    result.eigensolver_failed = true;
-    return result;
-  }
-  result.eta = matrix->proven_shift();
-  if (result.eta <= eta_max) {  // Certified with a larger shift.
-    result.certified = true;
-    return result;
-  }
-  if (result.direction.size() > 0) {
-    // Negative curvature already found (FindNegativeCurvature) and the bound
-    // proven: nothing to tighten that could certify.
-    return result;
-  }
-  // lambda_min(S) > -c: the largest eigenvalue of (S + cI)^{-1} is
-  // 1 / (lambda_min + c).
-  ShiftInvertOperator op(matrix);
-  const int dim = matrix->dimension();
-  Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1, std::min(20, dim));
-  eigs.init();
-  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-8);
-  if (eigs.info() == Spectra::CompInfo::Successful) {
-    const double mu = eigs.eigenvalues()(0);
-    result.lambda_min_estimate = 1.0 / mu - c;
-    result.direction = eigs.eigenvectors().col(0).normalized();
-  } else {
-    LOG(WARNING) << "shift-and-invert Lanczos did not converge";
-  }
-  if (result.direction.size() == dim) {
-    result.direction_curvature = result.direction.dot(
-        MultiplyCertificate(problem, Lambda, result.direction));
-  }
-  // Tighten the shift to just above the estimate when that can certify.
-  if (std::isfinite(result.lambda_min_estimate) && result.eta > eta_max) {
-    const double tight =
-        std::max(eta_target, -1.05 * result.lambda_min_estimate);
-    if (tight < c) {
-      ++result.factorizations;
-      if (matrix->Factorize(Lambda, tight)) {
-        result.eta = std::min(result.eta, matrix->proven_shift());
-      }
+  if (!proven) return finish();  // Only round-off can make this fail.
+  if (result.eta <= eta_max) return finish();
+  if (result.direction.size() == 0) {
+    // lambda_min(S_mu) > -c: the largest eigenvalue of (S_mu + cI)^{-1} is
+    // 1 / (lambda_min + c). (Refactorize if the ladder failed after the
+    // poor-candidate test proved c_vacuous.)
+    if (!factor_is_current &&
+        !matrix->Prove(Lambda, factor_shift, ProofPrecision::kDouble)) {
+      return finish();
+    }
+    ShiftInvertOperator op(matrix);
+    const int dim = matrix->dimension();
+    Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1, std::min(20, dim));
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-8);
+    if (eigs.info() == Spectra::CompInfo::Successful) {
+      result.lambda_min_estimate = 1.0 / eigs.eigenvalues()(0) - factor_shift;
+      result.direction = eigs.eigenvectors().col(0).normalized();
+      result.direction_curvature = result.direction.dot(
+          MultiplyCertificate(problem, Lambda, result.direction));
+    } else {
+      LOG(WARNING) << "shift-and-invert Lanczos did not converge";
+    }
+    // Tighten the shift to just above the estimate when that can certify.
+    if (std::isfinite(result.lambda_min_estimate)) {
+      const double tight =
+          std::max(eta_target, -1.05 * result.lambda_min_estimate);
+      if (tight < factor_shift) prove(tight, ProofPrecision::kDouble);
     }
   }
-  if (result.eta <= eta_max) {
-    result.certified = true;
-    return result;
+  // No clear negative curvature of S itself (the direction's Rayleigh
+  // quotient, from products with Q, is above -eta_max): the failures were
+  // round-off (large maps: mu's cost); prove it in double-double.
+  if (use_extended && result.eta > eta_max &&
+      !(result.direction_curvature < -eta_max)) {
+    prove_extended();
   }
-  if (result.direction.size() != dim || !(result.direction_curvature < 0)) {
-    result.eigensolver_failed = true;
-  }
-  return result;
+  return finish();
 }
 
 }  // namespace ceres_sesync::internal

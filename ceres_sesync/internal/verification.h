@@ -10,12 +10,32 @@
 
 namespace ceres_sesync::internal {
 
+// Which arithmetic proves the certificate.
+enum class ProofPolicy {
+  kAutomatic,     // Double; double-double when double cannot reach the goal.
+  kDouble,        // Double only.
+  kDoubleDouble,  // Double-double only (double still finds saddle escapes).
+};
+
+struct VerificationOptions {
+  // First shift tried (the tightest proof worth attempting).
+  double eta_target = 0;
+  // Certified iff a shift <= eta_max is proven (the tolerance).
+  double eta_max = 0;
+  // A proof above this shift is tightened in double-double (kAutomatic);
+  // <= 0: the goal is out of reach, use eta_max.
+  double eta_goal = 0;
+  ProofPolicy policy = ProofPolicy::kAutomatic;
+};
+
 struct VerificationResult {
-  // S + eta I was proven positive definite with eta <= eta_max.
+  // S + eta I was proven positive semidefinite with eta <= eta_max.
   bool certified = false;
-  // Smallest shift c for which S + cI was proven positive definite (the
-  // certificate's slack); +infinity if none was.
+  // Smallest shift c for which S + cI was proven positive semidefinite (the
+  // certificate's slack), all round-off included; +infinity if none was.
   double eta = 0;
+  // The arithmetic of the factorization that proved eta (when finite).
+  ProofPrecision precision = ProofPrecision::kDouble;
   // Estimate of lambda_min(S) (an upper bound when it is from a Ritz value);
   // NaN if no eigensolve was needed.
   double lambda_min_estimate = 0;
@@ -28,25 +48,44 @@ struct VerificationResult {
   // S + (tr(Lambda) / dn) I is not positive definite: every provable shift
   // gives the vacuous bound tr(Lambda) - eta d n < 0 (eta > tr(Lambda) / dn).
   bool vacuous_bound = false;
+  // Factorizations in double and in double-double, and the seconds spent in
+  // the latter.
   int factorizations = 0;
+  int extended_factorizations = 0;
+  double extended_time_s = 0;
 };
+
+// A lower bound, rounded down, on tr(Lambda) - eta d n (the dual objective
+// of the multipliers Lambda - eta I, which is a lower bound on the optimum
+// once S + eta I >= 0 is proven): the trace is summed in double-double.
+double ProvenLowerBound(const Eigen::MatrixXd& Lambda, int d, double eta);
 
 // S v for the d x dn multipliers Lambda.
 Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
                                     const Eigen::MatrixXd& Lambda,
                                     const Eigen::VectorXd& v);
 
-// Tests S + eta_target I, then larger shifts by factors of 16 up to
-// lambda_max(Lambda) (where S + cI is positive definite since Q is PSD).
-// Certified iff the smallest proven shift is <= eta_max; otherwise a
-// negative-curvature direction is computed by shift-and-invert Lanczos.
-// Poor candidates: one factorization at c = tr(Lambda) / dn (above which
-// every bound is vacuous) caps the bracketing there when it succeeds; when it
-// fails (vacuous_bound), the witness comes from Lanczos on S (eta = +inf) or,
-// if that does not converge, the bracketing starts there.
+// Proves the smallest shift it can (a complete proof, CertificateMatrix::
+// Prove):
+//  1. a proof at eta_target, then in double at eta_goal / 4; done if one
+//     proves a shift <= the goal;
+//  2. one factorization (no proof) at eta_max tells a near-optimal Lambda
+//     (it succeeds: lambda_min(S) > -eta_max up to double round-off) from a
+//     saddle or poor candidate;
+//  3. near-optimal: proofs at eta_goal / 16, eta_goal, eta_max, in
+//     double-double unless the policy is kDouble (then double, at shifts
+//     guided by a shift-and-invert Lanczos estimate);
+//  4. otherwise: a witness of negative curvature (for the staircase's escape
+//     and Certify's report) from Lanczos on S or, where that does not
+//     converge, shift-and-invert Lanczos on the first proven shift of a
+//     ladder (factors of 16 up to lambda_max(Lambda), where S + cI is
+//     positive definite since Q is PSD). Poor candidates: one factorization
+//     at c = tr(Lambda) / dn (above which every bound is vacuous) caps the
+//     ladder there when it succeeds; when it fails (vacuous_bound) the
+//     ladder starts there.
 VerificationResult VerifyCertificate(const SESyncProblem& problem,
                                      const Eigen::MatrixXd& Lambda,
-                                     double eta_target, double eta_max,
+                                     const VerificationOptions& options,
                                      CertificateMatrix* matrix);
 
 }  // namespace ceres_sesync::internal

@@ -22,6 +22,7 @@ from . import _ceres_sesync as _core
 from ._ceres_sesync import (
     Certificate,
     CertifyOptions,
+    CityOptions,
     ComponentsResult,
     ComponentsSummary,
     CubeOptions,
@@ -33,6 +34,7 @@ from ._ceres_sesync import (
     PoseGraph,
     PoseGraphComponent,
     Preconditioner,
+    ProofArithmetic,
     SolveResult,
     SolverOptions,
     SolverProgress,
@@ -44,6 +46,7 @@ __version__ = _core.__version__
 __all__ = [
     "Certificate",
     "CertifyOptions",
+    "CityOptions",
     "ComponentsResult",
     "ComponentsSummary",
     "CubeOptions",
@@ -55,12 +58,14 @@ __all__ = [
     "PoseGraph",
     "PoseGraphComponent",
     "Preconditioner",
+    "ProofArithmetic",
     "SolveResult",
     "SolverOptions",
     "SolverProgress",
     "SolverSummary",
     "certify",
     "evaluate_objective",
+    "generate_city",
     "generate_cube",
     "read_g2o",
     "read_g2o_poses",
@@ -215,6 +220,17 @@ def generate_cube(**options):
     return _core._generate_cube(_options(CubeOptions, options, "generate_cube"))
 
 
+def generate_city(**options):
+    """A large Manhattan-style random-walk map for scaling studies.
+
+    Keyword options are CityOptions fields (dimension=2, num_poses=10000,
+    loop_closure_probability=0.3, kappa=100, tau=100, seed=0, ...; see
+    ceres_sesync/city_generator.h). Returns (graph, true_rotations,
+    true_translations).
+    """
+    return _core._generate_city(_options(CityOptions, options, "generate_city"))
+
+
 # ---- solving and certifying --------------------------------------------------
 
 
@@ -223,8 +239,8 @@ def solve(graph, initial_rotations=None, **options):
 
     Keyword options are SolverOptions fields, e.g. max_rank=10,
     initialization="chordal"|"random"|"vertices", num_threads=0 (all cores),
-    max_time_s=0 (none), strict_round_off=False, progress=callable receiving
-    a SolverProgress at every stage and iteration. An unknown keyword raises
+    max_time_s=0 (none), proof_arithmetic="automatic"|"double"|"double_double",
+    progress=callable receiving a SolverProgress at every stage and iteration. An unknown keyword raises
     TypeError. initial_rotations ((n, d, d)) starts the staircase from those
     rotations instead.
 
@@ -292,6 +308,7 @@ def _options_repr(self):
 for _cls in (
     Certificate,
     CertifyOptions,
+    CityOptions,
     ComponentsResult,
     ComponentsSummary,
     ComponentsSummary.Component,
@@ -305,7 +322,14 @@ for _cls in (
     SolverSummary.Level,
 ):
     _cls.as_dict = _as_dict
-for _cls in (CertifyOptions, CubeOptions, G2oReadOptions, SolverOptions, SolverProgress):
+for _cls in (
+    CertifyOptions,
+    CityOptions,
+    CubeOptions,
+    G2oReadOptions,
+    SolverOptions,
+    SolverProgress,
+):
     _cls.__repr__ = _options_repr
 for _cls in (SolverSummary, ComponentsSummary):
     _cls.__repr__ = lambda self: f"<{type(self).__name__}: {self.brief_report}>"

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "ceres_sesync/certification.h"
+#include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/component_solver.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
@@ -139,6 +140,12 @@ void BindEnums(py::module_& m) {
   local.value("trust_region", O::LocalSolver::kTrustRegion)
       .value("ceres_lbfgs", O::LocalSolver::kCeresLbfgs);
   AcceptNames(local);
+  py::enum_<O::ProofArithmetic> proof(m, "ProofArithmetic",
+                                      "SolverOptions::ProofArithmetic");
+  proof.value("automatic", O::ProofArithmetic::kAutomatic)
+      .value("double", O::ProofArithmetic::kDouble)
+      .value("double_double", O::ProofArithmetic::kDoubleDouble);
+  AcceptNames(proof);
 }
 
 void BindSolverProgress(py::module_& m) {
@@ -181,9 +188,11 @@ void BindSolverOptions(py::module_& m) {
           &O::certification_target_relative_bound)
       .rw("certification_max_relative_bound",
           &O::certification_max_relative_bound)
+      .rw("certification_goal_relative_bound",
+          &O::certification_goal_relative_bound)
+      .rw("proof_arithmetic", &O::proof_arithmetic)
       .rw("certification_max_rounding_gap", &O::certification_max_rounding_gap)
       .rw("min_relative_eta", &O::min_relative_eta)
-      .rw("strict_round_off", &O::strict_round_off)
       .rw("refine_rounded_solution", &O::refine_rounded_solution)
       .rw("num_threads", &O::num_threads)
       .rw("max_time_s", &O::max_time_s)
@@ -213,7 +222,9 @@ void BindSolverSummary(py::module_& m) {
       .ro("eta", &S::Level::eta)
       .ro("lambda_min_estimate", &S::Level::lambda_min_estimate)
       .ro("optimize_time_s", &S::Level::optimize_time_s)
-      .ro("verify_time_s", &S::Level::verify_time_s);
+      .ro("verify_time_s", &S::Level::verify_time_s)
+      .ro("factorizations", &S::Level::factorizations)
+      .ro("extended_factorizations", &S::Level::extended_factorizations);
   Fields(cls)
       .get("status", [](const S& s) { return s.StatusString(); })
       .ro("message", &S::message)
@@ -228,11 +239,14 @@ void BindSolverSummary(py::module_& m) {
       .ro("rounding_gap", &S::rounding_gap)
       .ro("lambda_min_estimate", &S::lambda_min_estimate)
       .ro("eta", &S::eta)
-      .ro("strict_round_off", &S::strict_round_off)
+      .ro("proof_precision", &S::proof_precision)
+      .ro("relaxation_exact", &S::relaxation_exact)
       .ro("final_rank", &S::final_rank)
       .ro("iterations", &S::iterations)
       .ro("hessian_vector_products", &S::hessian_vector_products)
       .ro("factorizations", &S::factorizations)
+      .ro("extended_factorizations", &S::extended_factorizations)
+      .ro("extended_proof_time_s", &S::extended_proof_time_s)
       .ro("levels", &S::levels)
       .ro("data_time_s", &S::data_time_s)
       .ro("initialization_time_s", &S::initialization_time_s)
@@ -266,8 +280,9 @@ void BindCertificate(py::module_& m) {
       .rw("rotation_warning_tolerance", &O::rotation_warning_tolerance)
       .rw("improve_if_not_certified", &O::improve_if_not_certified)
       .rw("solver_options", &O::solver_options)
-      .rw("num_threads", &O::num_threads)
-      .rw("strict_round_off", &O::strict_round_off);
+      .rw("goal_relative_suboptimality", &O::goal_relative_suboptimality)
+      .rw("proof_arithmetic", &O::proof_arithmetic)
+      .rw("num_threads", &O::num_threads);
   KeywordInit<O>(options, "CertifyOptions");
 
   using C = Certificate;
@@ -279,7 +294,10 @@ void BindCertificate(py::module_& m) {
       .ro("rotation_objective", &C::rotation_objective)
       .ro("lambda_min", &C::lambda_min)
       .ro("eta", &C::eta)
-      .ro("strict_round_off", &C::strict_round_off)
+      .ro("proof_precision", &C::proof_precision)
+      .ro("factorizations", &C::factorizations)
+      .ro("extended_factorizations", &C::extended_factorizations)
+      .ro("extended_proof_time_s", &C::extended_proof_time_s)
       .ro("lower_bound", &C::lower_bound)
       .ro("suboptimality_bound", &C::suboptimality_bound)
       .ro("relative_suboptimality_bound", &C::relative_suboptimality_bound)
@@ -649,6 +667,37 @@ void BindCube(py::module_& m) {
                           TranslationsArray(truth, d));
   });
   m.def("_expected_ground_truth_objective", &ExpectedGroundTruthObjective);
+
+  using CO = CityOptions;
+  py::class_<CO> city(m, "CityOptions",
+                      "ceres_sesync::CityOptions (city_generator.h).");
+  Fields(city)
+      .rw("dimension", &CO::dimension)
+      .rw("num_poses", &CO::num_poses)
+      .rw("lattice_scale", &CO::lattice_scale)
+      .rw("levels", &CO::levels)
+      .rw("turn_probability", &CO::turn_probability)
+      .rw("loop_closure_probability", &CO::loop_closure_probability)
+      .rw("max_loop_closures_per_visit", &CO::max_loop_closures_per_visit)
+      .rw("kappa", &CO::kappa)
+      .rw("tau", &CO::tau)
+      .rw("spacing", &CO::spacing)
+      .rw("seed", &CO::seed);
+  KeywordInit<CO>(city, "CityOptions");
+  m.def("_generate_city", [](const CO& options) {
+    PoseGraph graph;
+    Poses truth;
+    std::string error;
+    bool ok;
+    {
+      py::gil_scoped_release release;  // 10^6 poses take seconds
+      ok = GenerateCity(options, &graph, &truth, &error);
+    }
+    if (!ok) InputError(error);
+    const int d = graph.dimension;
+    return py::make_tuple(std::move(graph), RotationsArray(truth, d),
+                          TranslationsArray(truth, d));
+  });
 }
 
 void BindSolvers(py::module_& m) {
