@@ -142,3 +142,18 @@ def test_graph_is_immutable():
     ms = g.measurements
     ms.kappa[:] = -1  # a copy: the graph is unchanged
     assert np.all(g.measurements.kappa > 0)
+
+
+def test_generated_graphs():
+    g, R, t = cs.generate_cube(side=3, dimension=2, seed=7)
+    assert (g.dimension, g.num_poses) == (2, 9)
+    assert R.shape == (9, 2, 2) and t.shape == (9, 2)
+    city, R, t = cs.generate_city(num_poses=300, seed=2)
+    assert (city.dimension, city.num_poses) == (2, 300)
+    assert city.num_measurements > 299  # odometry plus loop closures
+    np.testing.assert_array_equal(t[0], [0, 0])
+    assert cs.solve(city).certified
+    with pytest.raises(ValueError):
+        cs.generate_city(num_poses=1)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'side'"):
+        cs.generate_city(side=3)

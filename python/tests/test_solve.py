@@ -39,6 +39,10 @@ def test_results_equal_the_cpp_api(tmp_path, name):
         ("hessian_vector_products", r.hessian_vector_products),
     ]:
         assert value == cpp[key], key
+    assert r.relaxation_exact == cpp["relaxation_exact"]
+    assert r.proof_precision == cpp["proof"]["precision"]
+    assert r.factorizations == cpp["proof"]["factorizations"]
+    assert r.extended_factorizations == cpp["proof"]["extended_factorizations"]
     # The poses the program wrote (shortest round-trip decimals; rotations
     # through angles / quaternions).
     R, t = cs.read_g2o_poses(out, g)
@@ -65,6 +69,12 @@ def test_options_by_keyword():
     s = cs.solve(g, initialization=cs.Initialization.random, seed=5, initial_rank=4, max_rank=4)
     assert s.objective == r.objective  # the same seed: the same solve
     assert cs.solve(g, preconditioner="block_jacobi").certified
+    double = cs.solve(g, proof_arithmetic="double")
+    assert double.certified and double.proof_precision == "double"
+    assert double.extended_factorizations == 0
+    extended = cs.solve(g, proof_arithmetic=cs.ProofArithmetic.double_double)
+    assert extended.certified and extended.proof_precision == "double-double"
+    assert extended.extended_factorizations >= 1
     options = cs.SolverOptions(max_rank=7, local_solver="trust_region")
     assert options.max_rank == 7 and options.local_solver == cs.LocalSolver.trust_region
     assert options.as_dict()["max_rank"] == 7
