@@ -23,7 +23,7 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
   if (!staircase.Initialize(initial, &Y)) return {};
   staircase.Run(&Y);
   Poses poses = staircase.Round(Y);
-  staircase.Report(poses);
+  staircase.Report(Y, poses);
   return poses;
 }
 

@@ -248,7 +248,24 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
   }
 }
 
-VerificationResult Staircase::Verify(double sdp_value) {
+namespace {
+
+ProofPolicy ToPolicy(SolverOptions::ProofArithmetic arithmetic) {
+  switch (arithmetic) {
+    case SolverOptions::ProofArithmetic::kAutomatic:
+      return ProofPolicy::kAutomatic;
+    case SolverOptions::ProofArithmetic::kDouble:
+      return ProofPolicy::kDouble;
+    case SolverOptions::ProofArithmetic::kDoubleDouble:
+      return ProofPolicy::kDoubleDouble;
+  }
+  return ProofPolicy::kAutomatic;
+}
+
+}  // namespace
+
+VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
+                                     double sdp_value) {
   const int d = d_, n = n_;
   const double eta_floor = options_.min_relative_eta * scale_;
   auto shift = [&](double relative_bound) {
@@ -261,16 +278,24 @@ VerificationResult Staircase::Verify(double sdp_value) {
       shift(options_.certification_max_relative_bound);
   verification_options.eta_goal =
       shift(options_.certification_goal_relative_bound);
-  switch (options_.proof_arithmetic) {
-    case SolverOptions::ProofArithmetic::kAutomatic:
-      verification_options.policy = ProofPolicy::kAutomatic;
-      break;
-    case SolverOptions::ProofArithmetic::kDouble:
+  verification_options.policy = ToPolicy(options_.proof_arithmetic);
+  // The rounded poses cannot be proven closer to the optimum than their
+  // rounding gap. When Algorithm 2 applied to Y now (an upper bound on the
+  // final gap, before refinement) already misses the goal, the relaxation
+  // is not exact here and a double-double proof tighter than double's
+  // would mostly be wasted: it is deferred to Report(), which runs it only
+  // if the tolerance needs it.
+  extended_deferred_ = false;
+  if (verification_options.policy == ProofPolicy::kAutomatic && Y.rows() > d &&
+      sdp_value > 0) {
+    const Eigen::MatrixXd R = RoundSolution(Y, d);
+    Eigen::MatrixXd RQ;
+    problem_->MultiplyQ(R, &RQ);
+    const double gap = (R.cwiseProduct(RQ).sum() - sdp_value) / sdp_value;
+    if (gap > options_.certification_goal_relative_bound) {
       verification_options.policy = ProofPolicy::kDouble;
-      break;
-    case SolverOptions::ProofArithmetic::kDoubleDouble:
-      verification_options.policy = ProofPolicy::kDoubleDouble;
-      break;
+      extended_deferred_ = true;
+    }
   }
   VerificationResult verification = VerifyCertificate(
       *problem_, cost_->Lambda(), verification_options, certificate_.get());
@@ -317,7 +342,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
 
     Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
     t = Clock::now();
-    verification_ = Verify(sdp_value_);
+    verification_ = Verify(*Y, sdp_value_);
     level.verify_time_s =
         std::chrono::duration<double>(Clock::now() - t).count();
     level.certified = verification_.certified;
@@ -404,10 +429,43 @@ Poses Staircase::Round(const Eigen::MatrixXd& Y) {
   return poses;
 }
 
-void Staircase::Report(const Poses& poses) {
+void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
   SolverSummary& s = *summary_;
-  s.sdp_value = sdp_value_;
+  const int dn = d_ * n_;
+  const double tol = options_.certification_max_relative_bound;
+  // Certified iff lower bound >= F(x) / (1 + tol), i.e. eta <= eta_max:
+  const double eta_max = (sdp_value_ - objective / (1 + tol)) / dn;
+  if (!(eta_max > 0) || verification_.eta <= eta_max) return;
+  const auto t = Clock::now();
+  cost_->Evaluate(Y);  // Lambda at Y again (rounding moved the cost).
+  VerificationOptions o;
+  o.eta_target =
+      std::max(options_.min_relative_eta * scale_,
+               options_.certification_target_relative_bound * sdp_value_ / dn);
+  o.eta_max = eta_max;
+  o.eta_goal = eta_max / 4;
+  o.policy = ProofPolicy::kDoubleDouble;
+  const VerificationResult v =
+      VerifyCertificate(*problem_, cost_->Lambda(), o, certificate_.get());
+  s.factorizations += v.factorizations;
+  s.extended_factorizations += v.extended_factorizations;
+  s.extended_proof_time_s += v.extended_time_s;
+  s.verification_time_s +=
+      std::chrono::duration<double>(Clock::now() - t).count();
+  if (v.eta < verification_.eta) {
+    verification_.eta = v.eta;
+    verification_.precision = v.precision;
+    lower_bound_ = ProvenLowerBound(cost_->Lambda(), d_, v.eta);
+  }
+}
+
+void Staircase::Report(const Eigen::MatrixXd& Y, const Poses& poses) {
+  SolverSummary& s = *summary_;
   s.objective = EvaluateObjective(graph_, poses);
+  if (extended_deferred_ && verification_.certified) {
+    TightenProof(Y, s.objective);
+  }
+  s.sdp_value = sdp_value_;
   s.eta = verification_.eta;
   s.lambda_min_estimate = verification_.lambda_min_estimate;
   s.proof_precision = std::isfinite(s.eta)

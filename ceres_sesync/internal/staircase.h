@@ -66,18 +66,22 @@ class Staircase {
   // status). On return Y is the final factor and the cost is evaluated there.
   void Run(Eigen::MatrixXd* Y);
 
-  // Stage "verify", for the current point of the cost (Lambda at Y) with
+  // Stage "verify", for the current point Y of the cost (Lambda at Y) with
   // F(Y) = sdp_value: proves S + eta I positive semidefinite for the smallest
-  // eta it can, within the options' certification targets.
-  VerificationResult Verify(double sdp_value);
+  // eta it can, within the options' certification targets (the goal raised
+  // to the rounding gap of Y when that is larger).
+  VerificationResult Verify(const Eigen::MatrixXd& Y, double sdp_value);
 
   // Stage "round": Algorithm 2 on Y, the optional refinement on SO(d)^n, the
   // optimal translations (eq. 21), in the documented gauge.
   Poses Round(const Eigen::MatrixXd& Y);
 
   // Stage "report": objective, lower bound, suboptimality bounds, rounding
-  // gap, final status and total time for the returned `poses`.
-  void Report(const Poses& poses);
+  // gap, final status and total time for the returned `poses` (rounded from
+  // Y). When the relaxation proved not exact and double precision left the
+  // poses' bound above the tolerance, the proof is tightened in
+  // double-double first (the only case Verify() defers it).
+  void Report(const Eigen::MatrixXd& Y, const Poses& poses);
 
   const SESyncProblem& problem() const { return *problem_; }
   SESyncCost& cost() { return *cost_; }
@@ -95,6 +99,8 @@ class Staircase {
   double RemainingTime() const;
   // One level's local optimization (RTR or Ceres LBFGS) from Y.
   void Optimize(int rank, Eigen::MatrixXd* Y, SolverSummary::Level* level);
+  // The deferred double-double proof (see Report()).
+  void TightenProof(const Eigen::MatrixXd& Y, double objective);
   // Escapes the saddle at rank r along the verification's direction; false
   // if no descent was found.
   bool Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus);
@@ -115,6 +121,8 @@ class Staircase {
   VerificationResult verification_;
   double sdp_value_ = 0;
   double lower_bound_ = 0;  // Proven at the last verification.
+  // The last verification skipped double-double (not exact: see Verify()).
+  bool extended_deferred_ = false;
 };
 
 // Poses from rotations R (d x dn) and translations T (d x n), expressed in the
