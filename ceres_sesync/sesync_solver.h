@@ -34,7 +34,9 @@ struct SolverProgress {
   // "data" (data matrices, factorizations), "initialize", "optimize" (one
   // report when a staircase level starts, iteration 0, then one per local
   // solver iteration), "verify" (the certificate of a level), "round",
-  // "done" (objective = F(x) of the returned poses). Static strings.
+  // "prove" (a deferred double-double proof for the rounded poses, when
+  // needed), "done" (objective = F(x) of the returned poses). Static
+  // strings.
   const char* stage = "";
   int rank = 0;       // Staircase rank (0 before the staircase).
   int iteration = 0;  // Local-solver iteration within the level.

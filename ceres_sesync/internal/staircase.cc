@@ -436,6 +436,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
   // Certified iff lower bound >= F(x) / (1 + tol), i.e. eta <= eta_max:
   const double eta_max = (sdp_value_ - objective / (1 + tol)) / dn;
   if (!(eta_max > 0) || verification_.eta <= eta_max) return;
+  Progress("prove", s.final_rank, s.iterations, sdp_value_);
   const auto t = Clock::now();
   cost_->Evaluate(Y);  // Lambda at Y again (rounding moved the cost).
   VerificationOptions o;
