@@ -47,6 +47,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "ceres_sesync/ceres_baseline.h"
 #include "ceres_sesync/certification.h"
 #include "ceres_sesync/chordal_initialization.h"
@@ -100,33 +101,20 @@ DEFINE_int32(lbfgs_repeats, 1,
 namespace ceres_sesync {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using bench::CeresStatus;
+using bench::Clock;
+using bench::CsvField;
+using bench::Fmt;
+using bench::Median;
+using bench::Min;
+using bench::PeakRssMiB;
+using bench::SecondsSince;
+using bench::Sum;
 
 // Whether to run repeat number `done` (0-based) given the time `spent` so
 // far: at least `repeats` runs, more until --min_time (100 runs at most).
 bool Again(int done, int repeats, double spent, bool extend = true) {
   return done < repeats || (extend && spent < FLAGS_min_time && done < 100);
-}
-
-double Sum(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return s;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t k = v.size() / 2;
-  return v.size() % 2 ? v[k] : 0.5 * (v[k - 1] + v[k]);
-}
-
-double Min(const std::vector<double>& v) {
-  return v.empty() ? NAN : *std::min_element(v.begin(), v.end());
 }
 
 // Optimal values of Tables 1-2 of the paper, as cited in
@@ -153,6 +141,9 @@ struct Row {
   std::string certified;  // yes / no / error / "".
   double lower_bound = NAN;
   double rel_subopt_bound = NAN;
+  // The certificate's proof: arithmetic, factorizations (double +
+  // double-double) and the double-double seconds.
+  std::string proof;
   int iterations = -1;
   std::string status;    // converged / timeout / max_iterations / ...
   double speedup = NAN;  // time_min / SE-Sync time_min.
@@ -165,13 +156,6 @@ struct Stages {
   SolverSummary summary;
   double wall_s = 0;
 };
-
-std::string Fmt(const char* format, double v) {
-  if (std::isnan(v)) return "";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, v);
-  return buf;
-}
 
 std::string BaseName(const std::string& path) {
   return std::filesystem::path(path).stem().string();
@@ -196,6 +180,10 @@ void CertifyInto(const PoseGraph& graph, const Poses& poses, Row* row,
   row->certified = certificate.certified ? "yes" : "no";
   row->lower_bound = certificate.lower_bound;
   row->rel_subopt_bound = certificate.relative_suboptimality_bound;
+  row->proof = certificate.proof_precision + " (" +
+               std::to_string(certificate.factorizations) + "+" +
+               std::to_string(certificate.extended_factorizations) + ", " +
+               Fmt("%.3f", certificate.extended_proof_time_s) + " s)";
   const double tol = CertifyOptions().max_relative_suboptimality;
   if (certificate.certified &&
       !(certificate.relative_suboptimality_bound <= tol * (1 + 1e-9))) {
@@ -205,19 +193,6 @@ void CertifyInto(const PoseGraph& graph, const Poses& poses, Row* row,
                  << ": Certify says certified but its relative bound is "
                  << certificate.relative_suboptimality_bound;
   }
-}
-
-std::string CeresStatus(const CeresBaselineSummary& s) {
-  const ceres::Solver::Summary& c = s.solver_summary;
-  if (c.termination_type == ceres::CONVERGENCE) return "converged";
-  if (c.termination_type == ceres::NO_CONVERGENCE) {
-    if (c.message.find("time") != std::string::npos) return "timeout";
-    if (c.message.find("iteration") != std::string::npos) {
-      return "max_iterations";
-    }
-    return "no_convergence";
-  }
-  return ceres::TerminationTypeToString(c.termination_type);
 }
 
 // Runs Ceres `repeats` times from `initial` (whose computation took
@@ -259,21 +234,6 @@ Row RunCeres(const PoseGraph& graph, const std::string& dataset,
                row.method.c_str(), init.c_str(), Min(row.times), row.objective,
                row.status.c_str(), row.certified.c_str());
   return row;
-}
-
-// Peak resident set size of this process so far (VmHWM), in MiB.
-double PeakRssMiB() {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) {
-      std::istringstream s(line.substr(6));
-      double kb = 0;
-      s >> kb;
-      return kb / 1024.0;
-    }
-  }
-  return NAN;
 }
 
 // A short form of a level's termination message ("ceres LBFGS: Function
@@ -327,6 +287,9 @@ bool RunSESync(const PoseGraph& graph, const std::string& dataset,
   }
   row->lower_bound = s.lower_bound;
   row->rel_subopt_bound = s.relative_suboptimality_bound;
+  row->proof = s.proof_precision + " (" + std::to_string(s.factorizations) +
+               "+" + std::to_string(s.extended_factorizations) + ", " +
+               Fmt("%.3f", s.extended_proof_time_s) + " s)";
   row->iterations = s.iterations;
   row->status = s.StatusString() + ", rank " + std::to_string(s.final_rank);
   if (options.local_solver == SolverOptions::LocalSolver::kCeresLbfgs) {
@@ -494,13 +457,6 @@ bool BenchDataset(const std::string& path, int repeats,
   return true;
 }
 
-std::string CsvField(const std::string& s) {
-  if (s.find_first_of(",\"") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += (c == '"') ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
 }  // namespace
 }  // namespace ceres_sesync
 
@@ -614,15 +570,16 @@ int main(int argc, char** argv) {
 
   std::ostringstream md;
   md << "| dataset | n | m | method | init | time min [s] | time median [s] "
-        "| chordal [s] | objective | certified | rel. subopt. bound | "
-        "iterations | time / SE-Sync | status |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| chordal [s] | objective | certified | rel. subopt. bound | proof "
+        "(factorizations double+dd, dd time) | iterations | time / SE-Sync | "
+        "status |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     md << "| " << r.dataset << " | " << r.n << " | " << r.m << " | " << r.method
        << " | " << r.init << " | " << Fmt("%.4f", Min(r.times)) << " | "
        << Fmt("%.4f", Median(r.times)) << " | " << Fmt("%.4f", r.chordal_time_s)
        << " | " << Fmt("%.6e", r.objective) << " | " << r.certified << " | "
-       << Fmt("%.2e", r.rel_subopt_bound) << " | "
+       << Fmt("%.2e", r.rel_subopt_bound) << " | " << r.proof << " | "
        << (r.iterations >= 0 ? std::to_string(r.iterations) : "") << " | "
        << Fmt("%.2f", r.speedup) << " | " << r.status << " |\n";
   }
@@ -681,7 +638,7 @@ int main(int argc, char** argv) {
   {
     std::ofstream out(FLAGS_out_dir + "/bench.csv");
     out << "dataset,n,m,method,init,time_min_s,time_median_s,chordal_time_s,"
-           "objective,certified,lower_bound,rel_subopt_bound,iterations,"
+           "objective,certified,lower_bound,rel_subopt_bound,proof,iterations,"
            "speedup,status\n";
     for (const Row& r : rows) {
       out << r.dataset << "," << r.n << "," << r.m << "," << CsvField(r.method)
@@ -689,7 +646,7 @@ int main(int argc, char** argv) {
           << Fmt("%.6g", Median(r.times)) << ","
           << Fmt("%.6g", r.chordal_time_s) << "," << Fmt("%.10g", r.objective)
           << "," << r.certified << "," << Fmt("%.10g", r.lower_bound) << ","
-          << Fmt("%.3e", r.rel_subopt_bound) << ","
+          << Fmt("%.3e", r.rel_subopt_bound) << "," << CsvField(r.proof) << ","
           << (r.iterations >= 0 ? std::to_string(r.iterations) : "") << ","
           << Fmt("%.4g", r.speedup) << "," << CsvField(r.status) << "\n";
     }
@@ -698,7 +655,8 @@ int main(int argc, char** argv) {
     std::ofstream out(FLAGS_out_dir + "/bench_stages.csv");
     out << "dataset,d,n,m,wall_s,data_s,initialization_s,optimization_s,"
            "verification_s,rounding_s,total_s,rank,iterations,"
-           "hessian_vector_products,status,method\n";
+           "hessian_vector_products,status,method,proof_precision,"
+           "factorizations,extended_factorizations,extended_proof_s\n";
     for (const Stages& st : stages) {
       const SolverSummary& s = st.summary;
       out << st.dataset << "," << st.d << "," << st.n << "," << st.m << ","
@@ -706,7 +664,10 @@ int main(int argc, char** argv) {
           << "," << s.optimization_time_s << "," << s.verification_time_s << ","
           << s.rounding_time_s << "," << s.total_time_s << "," << s.final_rank
           << "," << s.iterations << "," << s.hessian_vector_products << ","
-          << CsvField(s.StatusString()) << "," << CsvField(st.method) << "\n";
+          << CsvField(s.StatusString()) << "," << CsvField(st.method) << ","
+          << s.proof_precision << "," << s.factorizations << ","
+          << s.extended_factorizations << "," << s.extended_proof_time_s
+          << "\n";
     }
   }
   return failures ? 1 : 0;

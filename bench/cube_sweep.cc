@@ -44,6 +44,7 @@
 #include <tuple>
 #include <vector>
 
+#include "bench/bench_util.h"
 #include "ceres_sesync/ceres_baseline.h"
 #include "ceres_sesync/chordal_initialization.h"
 #include "ceres_sesync/cube_generator.h"
@@ -79,18 +80,12 @@ DEFINE_bool(sesync_only, false,
 namespace ceres_sesync {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t k = v.size() / 2;
-  return v.size() % 2 ? v[k] : 0.5 * (v[k - 1] + v[k]);
-}
+using bench::Clock;
+using bench::Fmt;
+using bench::Median;
+using bench::ParseDoubles;
+using bench::ParseInts;
+using bench::SecondsSince;
 
 // kappa whose Langevin RMS angle (eq. 63) is `rms` radians (bisection on
 // log kappa; the RMS angle decreases monotonically in kappa).
@@ -221,33 +216,6 @@ void RunCube(const std::string& sweep, double x, const CubeOptions& cube,
                  (*runs)[k].time_s, (*runs)[k].objective);
   }
   std::fputc('\n', stderr);
-}
-
-std::vector<double> ParseDoubles(const std::string& s) {
-  std::vector<double> out;
-  std::stringstream in(s);
-  std::string token;
-  while (std::getline(in, token, ',')) {
-    if (!token.empty()) out.push_back(std::stod(token));
-  }
-  return out;
-}
-
-std::vector<int> ParseInts(const std::string& s) {
-  std::vector<int> out;
-  std::stringstream in(s);
-  std::string token;
-  while (std::getline(in, token, ',')) {
-    if (!token.empty()) out.push_back(std::stoi(token));
-  }
-  return out;
-}
-
-std::string Fmt(const char* format, double v) {
-  if (std::isnan(v)) return "";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, v);
-  return buf;
 }
 
 void WriteRuns(const std::string& path, const std::vector<Run>& runs) {

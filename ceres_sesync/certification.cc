@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "ceres_sesync/internal/certificate_matrix.h"
+#include "ceres_sesync/internal/objective_bound.h"
 #include "ceres_sesync/internal/parallel.h"
 #include "ceres_sesync/internal/rounding.h"
 #include "ceres_sesync/internal/sesync_problem.h"
@@ -115,11 +116,14 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
     total_weight += e.kappa + e.tau;
   }
   const bool zero_objective = c.objective <= 1e-12 * total_weight;
-  c.suboptimality_bound = c.objective - c.lower_bound;
+  // F(candidate) rounded up: the bound must not rest on round-off in F.
+  c.suboptimality_bound =
+      internal::ObjectiveUpperBound(graph, projected) - c.lower_bound;
+  // A numerically zero F is optimal by F >= 0 (no ratio to a zero bound).
   c.relative_suboptimality_bound =
-      c.lower_bound > 0 ? c.suboptimality_bound / c.lower_bound
-      : zero_objective  ? 0
-                        : std::numeric_limits<double>::infinity();
+      zero_objective      ? 0
+      : c.lower_bound > 0 ? c.suboptimality_bound / c.lower_bound
+                          : std::numeric_limits<double>::infinity();
   // Certified iff the proven relative bound is within the tolerance.
   c.certified = zero_objective || c.relative_suboptimality_bound <=
                                       options.max_relative_suboptimality;

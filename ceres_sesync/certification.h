@@ -109,7 +109,9 @@ struct Certificate {
   // (F is a sum of squares). A candidate with F <= 1e-12 * sum(kappa + tau)
   // (e.g. a tree, or noiseless data) is certified by F >= 0 alone.
   double lower_bound = 0;
-  // objective - lower_bound, and that relative to lower_bound.
+  // (objective - lower_bound) and its ratio to lower_bound, with the
+  // objective rounded up by a bound on its own evaluation's round-off
+  // (internal/objective_bound.h; ~1e-12 relative).
   double suboptimality_bound = 0;
   double relative_suboptimality_bound = 0;
   // Largest Frobenius distance of a candidate rotation from SO(d).

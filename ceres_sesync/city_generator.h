@@ -77,7 +77,7 @@ struct CityOptions {
   // Rotational concentration kappa (> 0) of every measurement. The default
   // 100 is an RMS rotation error of 4.06 degrees per measurement (eq. 63).
   // At the cube's 16.67 (10 degrees) the relaxation is not exact on large
-  // maps (10^5 poses, seed 0: RELAXATION_NOT_EXACT, rounding gap 3e-5).
+  // maps (10^5 poses, seed 0: relaxation not exact, rounding gap 3e-5).
   double kappa = 100;
   // Translational precision tau (> 0) of every measurement. The default 100
   // is an RMS translation error of sqrt(d / 100) (0.14 m in 2D) per

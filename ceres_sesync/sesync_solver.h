@@ -217,7 +217,9 @@ struct SolverSummary {
   // <= 1e-12 sum(kappa + tau) (trees, noiseless data) are certified by F >= 0
   // alone.
   double lower_bound = 0;
-  // (objective - lower_bound) and its ratio to lower_bound.
+  // (objective - lower_bound) and its ratio to lower_bound, with the
+  // objective rounded up by a bound on its own evaluation's round-off
+  // (internal/objective_bound.h; ~1e-12 relative).
   double suboptimality_bound = 0;
   double relative_suboptimality_bound = 0;
   // Relative rounding gap (F(x) - F(Y)) / F(Y).

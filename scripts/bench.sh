@@ -2,13 +2,16 @@
 # Builds and runs the benchmark set (see bench/README.md) and regenerates
 # bench/results/.
 #
-#   scripts/bench.sh           full run (~40-60 min on 2 cores): bench over
-#                              every dataset (3 repeats), peak memory of
-#                              SE-Sync on the largest datasets, the cube
-#                              sweep (5 realizations) and scaling run, plots.
-#   scripts/bench.sh --quick   smoke run (seconds): bench --quick and
-#                              cube_sweep --quick into $BUILD_DIR/bench-quick
-#                              (bench/results is left alone).
+#   scripts/bench.sh           full run (~40-60 min on 2 cores, plus 1-3 h
+#                              for the scaling bench up to 10^6 poses):
+#                              bench over every dataset (3 repeats), peak
+#                              memory of SE-Sync on the largest datasets, the
+#                              cube sweep (5 realizations) and scaling run,
+#                              the scaling bench (city 2D/3D, cube), plots.
+#   scripts/bench.sh --quick   smoke run (seconds): bench --quick,
+#                              cube_sweep --quick and scaling --quick into
+#                              $BUILD_DIR/bench-quick (bench/results is left
+#                              alone).
 #
 # Environment: BUILD_DIR (default build/), BENCH_OUT (output directory;
 # default bench/results, or $BUILD_DIR/bench-quick with --quick).
@@ -24,7 +27,7 @@ fi
 "$root/scripts/install-deps.sh"
 build=${BUILD_DIR:-$root/build}
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j"$(nproc)" --target bench cube_sweep -- \
+cmake --build "$build" -j"$(nproc)" --target bench cube_sweep scaling -- \
   --no-print-directory >/dev/null
 bin=$build/bench
 py=/usr/bin/python3  # Debian's, with python3-matplotlib.
@@ -44,6 +47,8 @@ if [ $quick -eq 1 ]; then
   fi
   "$bin/cube_sweep" --quick --out_dir "$out" >"$out/cube_sweep.txt"
   "$py" "$root/bench/plot_cube_sweep.py" "$out"
+  "$bin/scaling" --quick --out_dir "$out" >"$out/scaling.txt"
+  "$py" "$root/bench/plot_scaling.py" "$out"
   echo "bench.sh --quick: outputs in $out ($(($(date +%s) - start)) s)"
   exit 0
 fi
@@ -76,8 +81,13 @@ done
 "$bin/cube_sweep" --realizations 5 --scaling_time_limit 120 \
   --out_dir "$out" | tee "$out/cube_sweep.txt"
 
-# 4) Plots.
+# 4) Scaling (issue #16): city 2D/3D from 10^3 to 10^6 poses and the cube,
+#    SE-Sync vs Ceres PDL-GN/LM from chordal, one process per run.
+"$bin/scaling" --ceres_max_time 600 --out_dir "$out" | tee "$out/scaling.txt"
+
+# 5) Plots.
 "$py" "$root/bench/plot_cube_sweep.py" "$out"
+"$py" "$root/bench/plot_scaling.py" "$out"
 "$py" "$root/bench/plot_trajectory.py" "$poses" "$out" --compare manhattan
 "$py" "$root/bench/plot_trajectory.py" "$poses" "$out" --datasets "" \
   --compare torus3D >/dev/null

@@ -7,6 +7,7 @@
 
 #include "ceres_sesync/internal/ceres_local_solver.h"
 #include "ceres_sesync/internal/chordal.h"
+#include "ceres_sesync/internal/objective_bound.h"
 #include "ceres_sesync/internal/parallel.h"
 #include "ceres_sesync/internal/rounding.h"
 #include "ceres_sesync/riemannian_trust_region.h"
@@ -478,12 +479,14 @@ void Staircase::Report(const Eigen::MatrixXd& Y, const Poses& poses) {
   s.lower_bound = std::max(0.0, lower_bound_);
   // The attained objective bounds the optimum too (guards F(Y) round-off).
   s.lower_bound = std::min(s.lower_bound, s.objective);
-  s.suboptimality_bound = std::max(0.0, s.objective - s.lower_bound);
+  // F(x) rounded up: the bound must not rest on round-off in F.
+  s.suboptimality_bound =
+      std::max(0.0, ObjectiveUpperBound(graph_, poses) - s.lower_bound);
+  // A numerically zero F is optimal by F >= 0 (no ratio to a zero bound).
   s.relative_suboptimality_bound =
-      s.lower_bound > 0 ? s.suboptimality_bound / s.lower_bound
-      : s.objective <= zero_objective_
-          ? 0
-          : std::numeric_limits<double>::infinity();
+      s.objective <= zero_objective_ ? 0
+      : s.lower_bound > 0            ? s.suboptimality_bound / s.lower_bound
+                                     : std::numeric_limits<double>::infinity();
   s.relaxation_exact =
       verification_.certified &&
       (s.rounding_gap <= options_.certification_max_rounding_gap ||
