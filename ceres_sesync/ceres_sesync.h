@@ -16,6 +16,8 @@
 //   certification.h           Certify(): a global-optimality certificate or a
 //                             suboptimality bound for ANY solution, e.g. one
 //                             computed by Ceres.
+//   component_solver.h        SolveByComponent(): a disconnected graph solved
+//                             per connected component, each in its own gauge.
 //   pose_conversions.h        Conversions to/from Eigen isometries,
 //                             quaternions, (x, y, yaw), and the pose maps and
 //                             constraint vectors of Ceres's examples/slam.
@@ -45,6 +47,7 @@
 #include "ceres_sesync/certification.h"
 #include "ceres_sesync/chordal_initialization.h"
 #include "ceres_sesync/city_generator.h"
+#include "ceres_sesync/component_solver.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/landmark_generator.h"

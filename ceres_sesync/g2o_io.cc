@@ -916,7 +916,7 @@ bool ParseG2oText(std::string_view text, const std::string& name,
 
   std::vector<int> component;
   const int num_components = ConnectedComponents(*graph, &component);
-  if (num_components > 1) {
+  if (num_components > 1 && !options.allow_disconnected) {
     const int n = graph->num_poses;
     std::vector<int> sizes(num_components, 0);
     for (int c : component) ++sizes[c];
@@ -940,7 +940,7 @@ bool ParseG2oText(std::string_view text, const std::string& name,
     return at.Fail(s.str());
   }
 
-  if (!graph->priors.empty()) {
+  if (!graph->priors.empty() && !options.allow_disconnected) {
     const int k = TranslationalComponents(*graph, &component);
     if (k > 1) {
       const int n = graph->num_poses;
@@ -961,6 +961,7 @@ bool ParseG2oText(std::string_view text, const std::string& name,
   std::string invalid;
   ValidationOptions validation;
   validation.allow_landmarks_and_priors = true;
+  validation.require_connected = !options.allow_disconnected;
   if (!ValidatePoseGraph(*graph, validation, &invalid)) {
     if (error) *error = name + ": invalid pose graph: " + invalid;
     return false;

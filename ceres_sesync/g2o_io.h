@@ -92,9 +92,10 @@
 // priors fix the gauge), files without edges, and disconnected graphs
 // (poses and landmarks; priors connect their poses through the world frame;
 // the translational terms must be connected too, see
-// TranslationalComponents in pose_graph.h).
-// The result always passes ValidatePoseGraph() with
-// ValidationOptions::allow_landmarks_and_priors.
+// TranslationalComponents in pose_graph.h), unless
+// G2oReadOptions::allow_disconnected is set. The result always passes
+// ValidatePoseGraph() with ValidationOptions::allow_landmarks_and_priors
+// (and require_connected = !allow_disconnected).
 //
 // Every writer replaces its output file atomically (temporary file + rename):
 // on failure no partial file is left behind.
@@ -117,6 +118,11 @@ struct G2oReadOptions {
   // reported with a glog warning. The legacy 3D TORO tags VERTEX3/EDGE3 are
   // rejected either way.
   bool skip_unsupported_tags = false;
+  // A disconnected measurement graph (including VERTEX lines without edges)
+  // is an error by default. If true it is accepted; the result then passes
+  // ValidatePoseGraph with ValidationOptions::require_connected false and can be
+  // solved per connected component (component_solver.h).
+  bool allow_disconnected = false;
 };
 
 struct G2oReadSummary {

@@ -243,20 +243,22 @@ bool ValidatePoseGraph(const PoseGraph& graph, const ValidationOptions& options,
         "the model does not have");
   }
 
-  const int k = ConnectedComponents(graph, nullptr);
-  if (k != 1) {
-    std::ostringstream s;
-    s << "measurement graph is disconnected: " << k << " components";
-    return fail(s.str());
-  }
-  if (!graph.priors.empty()) {  // Else the same as ConnectedComponents.
-    const int kt = TranslationalComponents(graph, nullptr);
-    if (kt != 1) {
+  if (options.require_connected) {
+    const int k = ConnectedComponents(graph, nullptr);
+    if (k != 1) {
       std::ostringstream s;
-      s << "the translational terms are disconnected: " << kt
-        << " components (a part tied to the rest only by rotation priors "
-           "would have a free translation)";
+      s << "measurement graph is disconnected: " << k << " components";
       return fail(s.str());
+    }
+    if (!graph.priors.empty()) {  // Else the same as ConnectedComponents.
+      const int kt = TranslationalComponents(graph, nullptr);
+      if (kt != 1) {
+        std::ostringstream s;
+        s << "the translational terms are disconnected: " << kt
+          << " components (a part tied to the rest only by rotation priors "
+             "would have a free translation)";
+        return fail(s.str());
+      }
     }
   }
   if (!options.allow_landmarks_and_priors && graph.has_landmarks_or_priors()) {

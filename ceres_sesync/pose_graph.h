@@ -168,6 +168,9 @@ struct ValidationOptions {
   // Solve) instead of silently ignoring the terms. The g2o reader and the
   // Ceres baseline, which support them, validate with true.
   bool allow_landmarks_and_priors = false;
+  // A disconnected graph passes when false (each component is then a pose
+  // graph of its own; see component_solver.h).
+  bool require_connected = true;
 };
 
 // Checks the structural and numerical invariants every solver relies on:
@@ -180,7 +183,8 @@ struct ValidationOptions {
 // together with priors; and a connected graph of poses and landmarks (see
 // ConnectedComponents: with priors, components linked through the world
 // frame count as connected) whose translational terms are connected too
-// (TranslationalComponents). A landmark seen by a single pose is fine.
+// (TranslationalComponents; with options.require_connected = false a
+// disconnected graph passes). A landmark seen by a single pose is fine.
 // Returns false with a message otherwise.
 bool ValidatePoseGraph(const PoseGraph& graph, const ValidationOptions& options,
                        std::string* error);

@@ -27,6 +27,29 @@
 
 namespace ceres_sesync {
 
+// What SolverOptions::progress receives: where the solve is and how it is
+// doing, for progress displays of long solves (tools/progress.h prints it).
+struct SolverProgress {
+  // The stage that starts (or, for "optimize", the iteration just done):
+  // "data" (data matrices, factorizations), "initialize", "optimize" (one
+  // report when a staircase level starts, iteration 0, then one per local
+  // solver iteration), "verify" (the certificate of a level), "round",
+  // "prove" (a deferred double-double proof for the rounded poses, when
+  // needed), "done" (objective = F(x) of the returned poses). Static
+  // strings.
+  const char* stage = "";
+  int rank = 0;       // Staircase rank (0 before the staircase).
+  int iteration = 0;  // Local-solver iteration within the level.
+  // F(Y) at the current iterate (F(x) for "done"; 0 when not known yet).
+  double objective = 0;
+  double gradient_norm = 0;  // Riemannian gradient norm (0 if not known).
+  double elapsed_s = 0;      // Wall-clock seconds since the solve started.
+  // Set by SolveByComponent (component_solver.h): the component being solved
+  // (0-based) and the number of components; 0 and 1 for a plain Solve.
+  int component = 0;
+  int num_components = 1;
+};
+
 struct SolverOptions {
   enum class Initialization {
     kChordal,   // Chordal relaxation (one sparse solve). Recommended.
@@ -141,6 +164,10 @@ struct SolverOptions {
   std::function<bool(int rank, int iteration, double f, double gradient_norm,
                      double trust_radius)>
       callback;
+  // Optional progress report (see SolverProgress): called at every stage
+  // boundary and after every trust-region iteration, always from the thread
+  // that called Solve. Must be cheap (throttle any output).
+  std::function<void(const SolverProgress&)> progress;
 };
 
 struct SolverSummary {

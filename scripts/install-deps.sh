@@ -7,6 +7,7 @@ packages=(
   libceres-dev libeigen3-dev libsuitesparse-dev libgoogle-glog-dev
   libgflags-dev libgtest-dev libgmock-dev libspectra-dev
   gnuplot-nox python3-matplotlib time
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
 )
 missing=()
 for p in "${packages[@]}"; do

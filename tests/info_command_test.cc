@@ -1,157 +1,30 @@
 // Tests of the JSON writer and of the `ceres_sesync info` command (run as a
 // separate process, as a user would).
 
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <string>
 
 #include "ceres_sesync/internal/json_writer.h"
 #include "gtest/gtest.h"
+#include "tests/util/json_validator.h"
+#include "tests/util/tool_runner.h"
 
 namespace ceres_sesync {
 namespace {
 
 namespace fs = std::filesystem;
-
-// ---- a minimal strict JSON validator (RFC 8259) ---------------------------
-
-class JsonValidator {
- public:
-  explicit JsonValidator(const std::string& text) : s_(text) {}
-
-  bool Valid() {
-    SkipSpace();
-    if (!Value()) return false;
-    SkipSpace();
-    return k_ == s_.size();
-  }
-
- private:
-  void SkipSpace() {
-    while (k_ < s_.size() && (s_[k_] == ' ' || s_[k_] == '\n' ||
-                              s_[k_] == '\r' || s_[k_] == '\t')) {
-      ++k_;
-    }
-  }
-  bool Literal(const char* word) {
-    const std::string w(word);
-    if (s_.compare(k_, w.size(), w) != 0) return false;
-    k_ += w.size();
-    return true;
-  }
-  bool Digits() {
-    const size_t start = k_;
-    while (k_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[k_]))) {
-      ++k_;
-    }
-    return k_ > start;
-  }
-  bool Number() {
-    if (s_[k_] == '-') ++k_;
-    if (k_ < s_.size() && s_[k_] == '0') {
-      ++k_;
-    } else if (!Digits()) {
-      return false;
-    }
-    if (k_ < s_.size() && s_[k_] == '.') {
-      ++k_;
-      if (!Digits()) return false;
-    }
-    if (k_ < s_.size() && (s_[k_] == 'e' || s_[k_] == 'E')) {
-      ++k_;
-      if (k_ < s_.size() && (s_[k_] == '+' || s_[k_] == '-')) ++k_;
-      if (!Digits()) return false;
-    }
-    return true;
-  }
-  bool String() {
-    if (s_[k_] != '"') return false;
-    for (++k_; k_ < s_.size(); ++k_) {
-      const unsigned char c = s_[k_];
-      if (c == '"') {
-        ++k_;
-        return true;
-      }
-      if (c < 0x20) return false;
-      if (c == '\\') {
-        if (++k_ >= s_.size()) return false;
-        const char e = s_[k_];
-        if (e == 'u') {
-          for (int h = 0; h < 4; ++h) {
-            if (++k_ >= s_.size() ||
-                !std::isxdigit(static_cast<unsigned char>(s_[k_]))) {
-              return false;
-            }
-          }
-        } else if (std::string("\"\\/bfnrt").find(e) == std::string::npos) {
-          return false;
-        }
-      }
-    }
-    return false;
-  }
-  template <typename Item>
-  bool Sequence(char close, Item item) {
-    ++k_;
-    SkipSpace();
-    if (k_ < s_.size() && s_[k_] == close) {
-      ++k_;
-      return true;
-    }
-    while (true) {
-      SkipSpace();
-      if (!item()) return false;
-      SkipSpace();
-      if (k_ >= s_.size()) return false;
-      if (s_[k_] == close) {
-        ++k_;
-        return true;
-      }
-      if (s_[k_++] != ',') return false;
-    }
-  }
-  bool Value() {
-    if (k_ >= s_.size()) return false;
-    switch (s_[k_]) {
-      case '{':
-        return Sequence('}', [&] {
-          if (k_ >= s_.size() || !String()) return false;
-          SkipSpace();
-          if (k_ >= s_.size() || s_[k_++] != ':') return false;
-          SkipSpace();
-          return Value();
-        });
-      case '[':
-        return Sequence(']', [&] { return Value(); });
-      case '"':
-        return String();
-      case 't':
-        return Literal("true");
-      case 'f':
-        return Literal("false");
-      case 'n':
-        return Literal("null");
-      default:
-        return Number();
-    }
-  }
-
-  const std::string& s_;
-  size_t k_ = 0;
-};
-
-bool IsValidJson(const std::string& text) {
-  return JsonValidator(text).Valid();
-}
+using test_util::IsValidJson;
+using test_util::JsonNumber;
+using test_util::ReadText;
+using test_util::RunResult;
+using test_util::RunToolWithOutput;
+using test_util::TempPath;
+using test_util::ValueAfter;
+using test_util::WriteText;
 
 TEST(JsonValidatorTest, RejectsInvalidDocuments) {
   // The validator must be able to say no, or the tests below prove nothing.
@@ -228,66 +101,6 @@ TEST(JsonWriterTest, NumbersRoundTripAndNonFiniteIsNull) {
 // ---- the `info` command
 // -------------------------------------------------------
 
-std::string TempPath(const std::string& name) {
-  return testing::TempDir() + "info_command_test_" + std::to_string(getpid()) +
-         "_" + name;
-}
-
-void WriteText(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  ASSERT_TRUE(out.good()) << path;
-}
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr.
-};
-
-// Runs the tool with `args` (paths here contain no shell metacharacters).
-RunResult RunTool(const std::string& args) {
-  RunResult result;
-  const std::string command =
-      std::string(CERES_SESYNC_TOOL) + " " + args + " 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) {
-    result.output.append(buffer, n);
-  }
-  const int status = pclose(pipe);
-  if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-  return result;
-}
-
-// The rest of the line after `label` in `text`, trimmed; "" if absent.
-std::string ValueAfter(const std::string& text, const std::string& label) {
-  const size_t at = text.find(label);
-  if (at == std::string::npos) return "";
-  size_t begin = at + label.size();
-  const size_t end = text.find('\n', begin);
-  while (begin < end && text[begin] == ' ') ++begin;
-  return text.substr(begin, end - begin);
-}
-
-// The number after `"key": ` at or after the first occurrence of `scope`.
-double JsonNumber(const std::string& json, const std::string& scope,
-                  const std::string& key) {
-  const size_t from = json.find(scope);
-  if (from == std::string::npos) return std::nan("");
-  const size_t at = json.find("\"" + key + "\": ", from);
-  if (at == std::string::npos) return std::nan("");
-  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
-}
-
 class InfoCommandTest : public testing::Test {
  protected:
   void SetUp() override {
@@ -314,7 +127,8 @@ TEST_F(InfoCommandTest, DescribesAGoodFile) {
   const std::string graph = TempPath("good.g2o");
   const std::string json_path = TempPath("good.json");
   WriteText(graph, kGoodGraph);
-  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  const RunResult run =
+      RunToolWithOutput("info " + graph + " --json " + json_path);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "dimension:"), "2") << run.output;
   EXPECT_EQ(ValueAfter(run.output, "poses:"), "3") << run.output;
@@ -355,7 +169,8 @@ TEST_F(InfoCommandTest, BadFileExitsWithTwoNamingTheLineAndWritesNoJson) {
             "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
             "\n"
             "EDGE_SE2 1 2 1 0 0 1 0 0 1 0 oops\n");
-  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  const RunResult run =
+      RunToolWithOutput("info " + graph + " --json " + json_path);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(run.output.find(graph + ":3: "), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(json_path));
@@ -368,15 +183,15 @@ TEST_F(InfoCommandTest, SkipUnsupportedTagsFlag) {
   WriteText(graph,
             "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
             "EDGE_BEARING_SE2_XY 0 5 0.5 1\n");
-  RunResult run = RunTool("info " + graph);
+  RunResult run = RunToolWithOutput("info " + graph);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(
       run.output.find(graph + ":2: unsupported tag 'EDGE_BEARING_SE2_XY'"),
       std::string::npos)
       << run.output;
 
-  run =
-      RunTool("info " + graph + " --skip_unsupported_tags --json " + json_path);
+  run = RunToolWithOutput("info " + graph + " --skip_unsupported_tags --json " +
+                          json_path);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "skipped lines:"), "1") << run.output;
   const std::string json = ReadText(json_path);
@@ -400,7 +215,7 @@ TEST_F(InfoCommandTest, CountsLandmarksAndPriors) {
             "EDGE_PRIOR_SE2_XY 0 0 0 9 0 9\n"
             "EDGE_PRIOR_SE2 1 1 0 0 0 0 0 0 0 3\n"
             "EDGE_PRIOR_SE2 0 0 0 0 1 0 0 1 0 3\n");
-  const RunResult run = RunTool("info " + graph + " --json " + json_path);
+  const RunResult run = RunToolWithOutput("info " + graph + " --json " + json_path);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "landmarks:"), "2") << run.output;
   EXPECT_EQ(ValueAfter(run.output, "landmark measurements:"), "3");
@@ -421,15 +236,16 @@ TEST_F(InfoCommandTest, CountsLandmarksAndPriors) {
 }
 
 TEST_F(InfoCommandTest, UsageErrorsExitWithTwo) {
-  EXPECT_EQ(RunTool("info").exit_code, 2);
+  EXPECT_EQ(RunToolWithOutput("info").exit_code, 2);
   const std::string missing = TempPath("missing.g2o");
-  const RunResult run = RunTool("info " + missing);
+  const RunResult run = RunToolWithOutput("info " + missing);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.output.find(missing), std::string::npos) << run.output;
   // An unwritable --json path is an error too.
   const std::string graph = TempPath("good2.g2o");
   WriteText(graph, kGoodGraph);
-  EXPECT_EQ(RunTool("info " + graph + " --json " + TempPath("no_dir/x.json"))
+  EXPECT_EQ(RunToolWithOutput("info " + graph + " --json " +
+                              TempPath("no_dir/x.json"))
                 .exit_code,
             2);
   fs::remove(graph);
@@ -438,7 +254,7 @@ TEST_F(InfoCommandTest, UsageErrorsExitWithTwo) {
 TEST_F(InfoCommandTest, DescribesABenchmarkDataset) {
   const std::string path = std::string(CERES_SESYNC_DATA_DIR) + "/CSAIL.g2o";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
-  const RunResult run = RunTool("info " + path);
+  const RunResult run = RunToolWithOutput("info " + path);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "edges:"), "1172") << run.output;
   EXPECT_EQ(ValueAfter(run.output, "poses:"), "1045") << run.output;

@@ -8,13 +8,14 @@
 #include "ceres_sesync/internal/json_writer.h"
 #include "gflags/gflags.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 
 DEFINE_double(max_relative_suboptimality,
               ceres_sesync::CertifyOptions().max_relative_suboptimality,
-              "certify: certified iff the proven relative suboptimality bound "
+              "Certified iff the proven relative suboptimality bound "
               "is at most this.");
 DEFINE_bool(improve, false,
-            "certify: if not certified, run SE-Sync from the candidate and "
+            "If not certified, run SE-Sync from the candidate and "
             "write the improved poses to --output.");
 
 namespace ceres_sesync::tools {
@@ -22,8 +23,8 @@ namespace ceres_sesync::tools {
 int RunCertify(const Args& args) {
   if (args.size() != 2) {
     std::fputs(
-        "usage: ceres_sesync certify GRAPH.g2o POSES.g2o "
-        "[--json CERT.json] [--improve --output IMPROVED.g2o]\n",
+        "usage: ceres_sesync certify GRAPH.g2o POSES.g2o [flags] (see "
+        "'ceres_sesync help certify')\n",
         stderr);
     return kUsageOrInputError;
   }
@@ -51,8 +52,14 @@ int RunCertify(const Args& args) {
   }
   options.solver_options.proof_arithmetic = options.proof_arithmetic;
   options.solver_options.num_threads = FLAGS_num_threads;
+  options.solver_options.verbose = FLAGS_verbose;
+  std::unique_ptr<ProgressPrinter> progress;
+  if (FLAGS_improve) progress = ProgressPrinterFromFlags();
+  if (progress) options.solver_options.progress = progress->Callback();
   Certificate certificate;
-  if (!Certify(graph, poses, options, &certificate, &error)) {
+  const bool ok = Certify(graph, poses, options, &certificate, &error);
+  if (progress) progress->Finish();
+  if (!ok) {
     std::fprintf(stderr, "ceres_sesync certify: %s: %s\n", args[1].c_str(),
                  error.c_str());
     return kUsageOrInputError;

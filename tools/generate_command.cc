@@ -15,33 +15,32 @@
 #include "gflags/gflags.h"
 #include "tools/commands.h"
 
-DEFINE_int32(side, 10,
-             "generate cube: side length s of the lattice, in poses.");
-DEFINE_int32(poses, 0, "generate city: number of poses n (required).");
+DEFINE_int32(side, 10, "Cube: side length s of the lattice, in poses.");
+DEFINE_int32(poses, 0, "City: number of poses n (required).");
 DEFINE_int32(dimension, 3,
-             "generate: cube: 3 for the s x s x s cube, 2 for the s x s "
+             "Cube: 3 for the s x s x s cube, 2 for the s x s "
              "grid; city: 2 (default) or 3.");
 DEFINE_double(loop_closure_probability, 0.1,
-              "generate: cube: probability pLC of a loop closure between "
+              "Cube: probability pLC of a loop closure between "
               "each pair of nearby non-sequential poses; city (default 0.3): "
               "probability of a closure to each earlier pose at a revisited "
               "lattice node (at most 2 per visit).");
 DEFINE_double(loop_closure_radius, 1.0,
-              "generate cube: loop-closure candidates are non-consecutive "
+              "Cube: loop-closure candidates are non-consecutive "
               "poses at most this many lattice units apart, in [1, 4] (1: "
               "lattice neighbours; sqrt(3): the 3 x 3 x 3 block).");
 DEFINE_double(kappa, 16.67,
-              "generate: rotational concentration of every measurement "
+              "Rotational concentration of every measurement "
               "(cube default 16.67 ~ 10 deg RMS; city default 100 ~ 4 deg).");
 DEFINE_double(tau, 75,
-              "generate: translational precision of every measurement (cube "
+              "Translational precision of every measurement (cube "
               "default 75 ~ 0.2 m RMS in 3D; city default 100).");
-DEFINE_uint64(seed, 0, "generate: random seed (deterministic output).");
+DEFINE_uint64(seed, 0, "Random seed (deterministic output).");
 DEFINE_string(ground_truth, "",
-              "generate: also write the ground-truth poses (VERTEX lines) to "
+              "Also write the ground-truth poses (VERTEX lines) to "
               "this g2o file.");
 DEFINE_string(vertices, "odometry",
-              "generate: VERTEX lines of --output: 'odometry' (dead reckoning "
+              "VERTEX lines of --output: 'odometry' (dead reckoning "
               "along the path, like recorded datasets), 'ground_truth', or "
               "'none'.");
 

@@ -3,39 +3,120 @@
 #include <cstdio>
 #include <iostream>
 
+#include "ceres_sesync/component_solver.h"
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/internal/json_writer.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "gflags/gflags.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 
-DEFINE_string(tum, "", "solve: also write the poses as a TUM trajectory.");
+DEFINE_string(tum, "", "Also write the poses as a TUM trajectory.");
 DEFINE_string(init, "chordal",
-              "solve: initialization, one of chordal|random|vertices.");
+              "Initialization, one of chordal|random|vertices.");
 DECLARE_uint64(seed);  // Defined in generate_command.cc.
-DEFINE_int32(initial_rank, 0, "solve: initial staircase rank (0: d + 2).");
-DEFINE_int32(max_rank, 10, "solve: maximum staircase rank.");
+DEFINE_int32(initial_rank, 0, "Initial staircase rank (0: d + 2).");
+DEFINE_int32(max_rank, 10, "Maximum staircase rank.");
 DEFINE_string(preconditioner, "q",
-              "solve: truncated-CG preconditioner: q (regularized Q, exact "
+              "Truncated-CG preconditioner: q (regularized Q, exact "
               "Schur complement)|cholesky (of Q's sparse part)|jacobi|none.");
 DEFINE_string(local_solver, "rtr",
-              "solve: staircase local solver: rtr (built-in trust region) | "
+              "Staircase local solver: rtr (built-in trust region) | "
               "ceres (ceres::GradientProblemSolver LBFGS).");
-DEFINE_double(max_time, 0, "solve: wall-clock limit in seconds (0: none).");
+DEFINE_double(max_time, 0, "Wall-clock limit in seconds (0: none).");
 DEFINE_double(
     gradient_tolerance,
     ceres_sesync::SolverOptions().relative_preconditioned_gradient_tolerance,
-    "solve: relative preconditioned gradient tolerance of the "
+    "Relative preconditioned gradient tolerance of the "
     "local solver.");
+DEFINE_bool(components, false,
+            "Solve a disconnected graph per connected component, each in its "
+            "own gauge (its first pose, or its FIX pose, fixed); the report "
+            "and --json list the components. Without it a disconnected graph "
+            "is an input error.");
 
 namespace ceres_sesync::tools {
+namespace {
+
+// The fields of a SolverSummary in the --json file (the whole solve, or one
+// component of --components).
+void AddSummary(const SolverSummary& summary, internal::JsonWriter* json) {
+  json->Int("num_poses", summary.num_poses);
+  json->Int("num_measurements", summary.num_measurements);
+  json->Int("dimension", summary.dimension);
+  json->Number("objective", summary.objective);
+  json->Number("sdp_value", summary.sdp_value);
+  json->Number("lower_bound", summary.lower_bound);
+  json->Number("suboptimality_bound", summary.suboptimality_bound);
+  json->Number("relative_suboptimality_bound",
+               summary.relative_suboptimality_bound);
+  json->Number("rounding_gap", summary.rounding_gap);
+  json->Number("lambda_min", summary.lambda_min_estimate);
+  json->Number("eta", summary.eta);
+  // Every proof accounts for all round-off (the key is kept for scripts).
+  json->Bool("strict_round_off", true);
+  json->Bool("certified", summary.certified());
+  json->Bool("relaxation_exact", summary.relaxation_exact);
+  json->Int("rank", summary.final_rank);
+  json->String("status", summary.StatusString());
+  json->Int("iterations", summary.iterations);
+  json->Int("hessian_vector_products", summary.hessian_vector_products);
+  json->BeginObject("proof");
+  json->String("precision", summary.proof_precision);
+  json->Int("factorizations", summary.factorizations);
+  json->Int("extended_factorizations", summary.extended_factorizations);
+  json->Number("extended_time_s", summary.extended_proof_time_s);
+  json->Number("verification_time_s", summary.verification_time_s);
+  json->EndObject();
+  json->BeginObject("time_s");
+  json->Number("data", summary.data_time_s);
+  json->Number("initialization", summary.initialization_time_s);
+  json->Number("optimization", summary.optimization_time_s);
+  json->Number("verification", summary.verification_time_s);
+  json->Number("rounding", summary.rounding_time_s);
+  json->EndObject();
+  json->Number("total_time_s", summary.total_time_s);
+}
+
+void AddComponents(const PoseGraph& graph, const ComponentsSummary& summary,
+                   internal::JsonWriter* json) {
+  json->Int("num_poses", summary.num_poses);
+  json->Int("num_measurements", summary.num_measurements);
+  json->Int("dimension", summary.dimension);
+  json->Number("objective", summary.objective);
+  json->Number("lower_bound", summary.lower_bound);
+  json->Number("suboptimality_bound", summary.suboptimality_bound);
+  json->Number("relative_suboptimality_bound",
+               summary.relative_suboptimality_bound);
+  json->Bool("certified", summary.certified());
+  json->String("status", summary.StatusString());
+  json->Number("total_time_s", summary.total_time_s);
+  json->Int("num_components", static_cast<int>(summary.components.size()));
+  json->BeginArray("components");
+  for (const ComponentsSummary::Component& c : summary.components) {
+    json->BeginObject();
+    json->Int("gauge_vertex_id", c.gauge_vertex_id);
+    json->BeginArray("vertex_ids");
+    for (int v : c.poses) json->Int(graph.vertex_ids[v]);
+    json->EndArray();
+    AddSummary(c.summary, json);
+    json->EndObject();
+  }
+  json->EndArray();
+}
+
+int InputError(const std::string& message) {
+  std::fprintf(stderr, "ceres_sesync solve: %s\n", message.c_str());
+  return kUsageOrInputError;
+}
+
+}  // namespace
 
 int RunSolve(const Args& args) {
   if (args.size() != 1) {
     std::fputs(
-        "usage: ceres_sesync solve GRAPH.g2o [--output POSES.g2o] "
-        "[--tum FILE] [--json SUMMARY.json] "
-        "[--init chordal|random|vertices] [--verbose]\n",
+        "usage: ceres_sesync solve GRAPH.g2o [flags] (see 'ceres_sesync help "
+        "solve')\n",
         stderr);
     return kUsageOrInputError;
   }
@@ -47,9 +128,7 @@ int RunSolve(const Args& args) {
   } else if (FLAGS_init == "vertices") {
     options.initialization = SolverOptions::Initialization::kVertices;
   } else {
-    std::fprintf(stderr, "ceres_sesync solve: unknown --init '%s'\n",
-                 FLAGS_init.c_str());
-    return kUsageOrInputError;
+    return InputError("unknown --init '" + FLAGS_init + "'");
   }
   if (FLAGS_preconditioner == "q") {
     options.preconditioner = SolverOptions::Preconditioner::kRegularizedQ;
@@ -60,16 +139,13 @@ int RunSolve(const Args& args) {
   } else if (FLAGS_preconditioner == "none") {
     options.preconditioner = SolverOptions::Preconditioner::kNone;
   } else {
-    std::fprintf(stderr, "ceres_sesync solve: unknown --preconditioner '%s'\n",
-                 FLAGS_preconditioner.c_str());
-    return kUsageOrInputError;
+    return InputError("unknown --preconditioner '" + FLAGS_preconditioner +
+                      "'");
   }
   if (FLAGS_local_solver == "ceres") {
     options.local_solver = SolverOptions::LocalSolver::kCeresLbfgs;
   } else if (FLAGS_local_solver != "rtr") {
-    std::fprintf(stderr, "ceres_sesync solve: unknown --local_solver '%s'\n",
-                 FLAGS_local_solver.c_str());
-    return kUsageOrInputError;
+    return InputError("unknown --local_solver '" + FLAGS_local_solver + "'");
   }
   options.seed = FLAGS_seed;
   options.initial_rank = FLAGS_initial_rank;
@@ -79,10 +155,8 @@ int RunSolve(const Args& args) {
   options.num_threads = FLAGS_num_threads;
   if (!ParseProofArithmetic(FLAGS_proof_arithmetic,
                             &options.proof_arithmetic)) {
-    std::fprintf(stderr,
-                 "ceres_sesync solve: unknown --proof_arithmetic '%s'\n",
-                 FLAGS_proof_arithmetic.c_str());
-    return kUsageOrInputError;
+    return InputError("unknown --proof_arithmetic '" + FLAGS_proof_arithmetic +
+                      "'");
   }
   options.relative_preconditioned_gradient_tolerance = FLAGS_gradient_tolerance;
 
@@ -90,79 +164,57 @@ int RunSolve(const Args& args) {
   PoseGraph graph;
   std::string error;
   G2oReadOptions read_options;
+  read_options.allow_disconnected = FLAGS_components;
   if (!ReadG2oFile(path, read_options, &graph, &error)) {
-    std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
-    return kUsageOrInputError;
+    if (error.find("measurement graph is disconnected") != std::string::npos) {
+      error += " (--components solves each component on its own)";
+    }
+    return InputError(error);
   }
   if (options.initialization == SolverOptions::Initialization::kVertices &&
       graph.initial_poses.empty()) {
-    std::fprintf(stderr,
-                 "ceres_sesync solve: %s: --init vertices, but the file has "
-                 "no VERTEX lines\n",
-                 path.c_str());
-    return kUsageOrInputError;
+    return InputError(path +
+                      ": --init vertices, but the file has no VERTEX lines");
   }
-  SolverSummary summary;
-  const Poses poses = Solve(graph, options, &summary);
-  std::cout << summary.FullReport() << std::flush;
-  if (summary.status == SolverSummary::Status::kInvalidInput) {
-    std::fprintf(stderr, "ceres_sesync solve: %s: %s\n", path.c_str(),
-                 summary.message.c_str());
-    return kUsageOrInputError;
+  std::unique_ptr<ProgressPrinter> progress = ProgressPrinterFromFlags();
+  if (progress) options.progress = progress->Callback();
+
+  Poses poses;
+  bool certified = false;
+  internal::JsonWriter json;
+  json.String("graph", path);
+  if (FLAGS_components) {
+    ComponentsSummary summary;
+    poses = SolveByComponent(graph, options, &summary);
+    if (progress) progress->Finish();
+    std::cout << summary.FullReport() << std::flush;
+    if (summary.status == SolverSummary::Status::kInvalidInput) {
+      return InputError(path + ": " + summary.message);
+    }
+    certified = summary.certified();
+    AddComponents(graph, summary, &json);
+  } else {
+    SolverSummary summary;
+    poses = Solve(graph, options, &summary);
+    if (progress) progress->Finish();
+    std::cout << summary.FullReport() << std::flush;
+    if (summary.status == SolverSummary::Status::kInvalidInput) {
+      return InputError(path + ": " + summary.message);
+    }
+    certified = summary.certified();
+    AddSummary(summary, &json);
   }
   if (!FLAGS_output.empty() &&
       !WriteG2oPoses(FLAGS_output, graph, poses, &error)) {
-    std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
-    return kUsageOrInputError;
+    return InputError(error);
   }
   if (!FLAGS_tum.empty() && !WriteTumFile(FLAGS_tum, graph, poses, &error)) {
-    std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
-    return kUsageOrInputError;
+    return InputError(error);
   }
-  if (!FLAGS_json.empty()) {
-    internal::JsonWriter json;
-    json.String("graph", path);
-    json.Int("num_poses", summary.num_poses);
-    json.Int("num_measurements", summary.num_measurements);
-    json.Int("dimension", summary.dimension);
-    json.Number("objective", summary.objective);
-    json.Number("sdp_value", summary.sdp_value);
-    json.Number("lower_bound", summary.lower_bound);
-    json.Number("suboptimality_bound", summary.suboptimality_bound);
-    json.Number("relative_suboptimality_bound",
-                summary.relative_suboptimality_bound);
-    json.Number("rounding_gap", summary.rounding_gap);
-    json.Number("lambda_min", summary.lambda_min_estimate);
-    json.Number("eta", summary.eta);
-    // Every proof accounts for all round-off (the key is kept for scripts).
-    json.Bool("strict_round_off", true);
-    json.Bool("certified", summary.certified());
-    json.Bool("relaxation_exact", summary.relaxation_exact);
-    json.Int("rank", summary.final_rank);
-    json.String("status", summary.StatusString());
-    json.Int("iterations", summary.iterations);
-    json.Int("hessian_vector_products", summary.hessian_vector_products);
-    json.BeginObject("proof");
-    json.String("precision", summary.proof_precision);
-    json.Int("factorizations", summary.factorizations);
-    json.Int("extended_factorizations", summary.extended_factorizations);
-    json.Number("extended_time_s", summary.extended_proof_time_s);
-    json.Number("verification_time_s", summary.verification_time_s);
-    json.EndObject();
-    json.BeginObject("time_s");
-    json.Number("data", summary.data_time_s);
-    json.Number("initialization", summary.initialization_time_s);
-    json.Number("optimization", summary.optimization_time_s);
-    json.Number("verification", summary.verification_time_s);
-    json.Number("rounding", summary.rounding_time_s);
-    json.EndObject();
-    json.Number("total_time_s", summary.total_time_s);
-    if (!json.WriteToFile(FLAGS_json, &error)) {
-      std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
-      return kUsageOrInputError;
-    }
+  if (!FLAGS_json.empty() && !json.WriteToFile(FLAGS_json, &error)) {
+    return InputError(error);
   }
-  return summary.certified() ? kSuccess : kNotCertified;
+  return certified ? kSuccess : kNotCertified;
 }
 
 bool ParseProofArithmetic(const std::string& name,

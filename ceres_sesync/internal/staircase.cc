@@ -98,6 +98,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     return;
   }
 
+  Progress("data");
   const auto t = Clock::now();
   problem_ = std::make_unique<SESyncProblem>(
       graph, ResolveNumThreads(options.num_threads));
@@ -129,6 +130,19 @@ double Staircase::Elapsed() const {
   return std::chrono::duration<double>(Clock::now() - start_).count();
 }
 
+void Staircase::Progress(const char* stage, int rank, int iteration,
+                         double objective, double gradient_norm) const {
+  if (!options_.progress) return;
+  SolverProgress p;
+  p.stage = stage;
+  p.rank = rank;
+  p.iteration = iteration;
+  p.objective = objective;
+  p.gradient_norm = gradient_norm;
+  p.elapsed_s = Elapsed();
+  options_.progress(p);
+}
+
 double Staircase::RemainingTime() const {
   return options_.max_time_s > 0
              ? std::max(1e-3, options_.max_time_s - Elapsed())
@@ -142,6 +156,7 @@ Poses Staircase::Trivial() const {
 
 bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
   SolverSummary& s = *summary_;
+  Progress("initialize");
   const auto t = Clock::now();
   const int d = d_, n = n_;
   Y->setZero(r0_, d * n);
@@ -185,6 +200,7 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
   // The gradient tolerance is relative to the final F, so repeat (cheaply,
   // from the current point) if F dropped below the guess.
   double f = cost.Evaluate(*Y);
+  Progress("optimize", rank, 0, f);
   const bool use_ceres =
       options_.local_solver == SolverOptions::LocalSolver::kCeresLbfgs;
   if (use_ceres) {
@@ -202,6 +218,7 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
       LOG(INFO) << "rank " << rank << " iter " << it << " F " << f << " |grad| "
                 << g << " radius " << radius << " tCG " << inner;
     }
+    Progress("optimize", rank, level->iterations + it, f, g);
     return !options_.callback || options_.callback(rank, it, f, g, radius);
   };
   for (int pass = 0; pass < 3 && !use_ceres; ++pass) {
@@ -332,6 +349,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
     sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
     level.sdp_value = sdp_value_;
 
+    Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
     t = Clock::now();
     verification_ = Verify(*Y, sdp_value_);
     level.verify_time_s =
@@ -394,6 +412,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
 
 Poses Staircase::Round(const Eigen::MatrixXd& Y) {
   SolverSummary& s = *summary_;
+  Progress("round", static_cast<int>(Y.rows()));
   const auto t = Clock::now();
   Eigen::MatrixXd R = RoundSolution(Y, d_);
   if (options_.refine_rounded_solution) {
@@ -426,6 +445,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
   // Certified iff lower bound >= F(x) / (1 + tol), i.e. eta <= eta_max:
   const double eta_max = (sdp_value_ - objective / (1 + tol)) / dn;
   if (!(eta_max > 0) || verification_.eta <= eta_max) return;
+  Progress("prove", s.final_rank, s.iterations, sdp_value_);
   const auto t = Clock::now();
   cost_->Evaluate(Y);  // Lambda at Y again (rounding moved the cost).
   VerificationOptions o;
@@ -496,6 +516,7 @@ void Staircase::Report(const Eigen::MatrixXd& Y, const Poses& poses) {
     s.message = message;
   }
   s.total_time_s = Elapsed();
+  Progress("done", s.final_rank, s.iterations, s.objective);
 }
 
 }  // namespace ceres_sesync::internal

@@ -92,6 +92,9 @@ class Staircase {
 
  private:
   double Elapsed() const;
+  // Calls options.progress (if set) with the current elapsed time.
+  void Progress(const char* stage, int rank = 0, int iteration = 0,
+                double objective = 0, double gradient_norm = 0) const;
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
   // One level's local optimization (RTR or Ceres LBFGS) from Y.

@@ -1,4 +1,5 @@
-// Runs the `ceres_sesync` command-line program from tests.
+// Runs the `ceres_sesync` command-line program from tests, as a user would,
+// and reads what it wrote.
 
 #ifndef CERES_SESYNC_TESTS_UTIL_TOOL_RUNNER_H_
 #define CERES_SESYNC_TESTS_UTIL_TOOL_RUNNER_H_
@@ -16,6 +17,32 @@ int RunTool(const std::string& arguments);
 
 // Whether `path` can be opened for reading.
 bool FileExists(const std::string& path);
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;     // stdout.
+  std::string err;     // stderr.
+  std::string output;  // out + err.
+};
+
+// Runs the tool with `arguments` (as RunTool), capturing stdout and stderr
+// separately; stdin is /dev/null.
+RunResult RunToolWithOutput(const std::string& arguments);
+
+// A path in the test's temporary directory, unique to this process.
+std::string TempPath(const std::string& name);
+// Writes `text` to `path` (a test failure if that fails).
+void WriteText(const std::string& path, const std::string& text);
+// The contents of `path` ("" if it cannot be read).
+std::string ReadText(const std::string& path);
+
+// The rest of the line after `label` in `text`, trimmed; "" if absent.
+std::string ValueAfter(const std::string& text, const std::string& label);
+
+// The number after `"key": ` at or after the first occurrence of `scope`
+// (NaN if absent).
+double JsonNumber(const std::string& json, const std::string& scope,
+                  const std::string& key);
 
 }  // namespace ceres_sesync::test_util
 

@@ -1,0 +1,198 @@
+// Tests of the `ceres_sesync` program's command line (run as a separate
+// process, as a user would): help, flag checking, progress output, and
+// `solve --components`.
+
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/util/json_validator.h"
+#include "tests/util/tool_runner.h"
+
+namespace ceres_sesync {
+namespace {
+
+namespace fs = std::filesystem;
+using test_util::IsValidJson;
+using test_util::JsonNumber;
+using test_util::ReadText;
+using test_util::RunResult;
+using test_util::RunToolWithOutput;
+using test_util::TempPath;
+using test_util::WriteText;
+using testing::HasSubstr;
+using testing::Not;
+
+class CliTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::string(CERES_SESYNC_TOOL).empty()) {
+      GTEST_SKIP() << "the ceres_sesync program is not built";
+    }
+  }
+};
+
+const char* const kCommands[] = {"info", "solve", "certify", "generate"};
+
+TEST_F(CliTest, HelpListsTheCommandsOwnFlagsWithTheirDefaults) {
+  for (const char* args :
+       {"help generate", "generate --help", "generate cube --help"}) {
+    SCOPED_TRACE(args);
+    const RunResult run = RunToolWithOutput(args);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_THAT(run.out, HasSubstr("usage: ceres_sesync generate cube"));
+    for (const char* flag :
+         {"--side=10\n", "--dimension=3\n", "--loop_closure_probability=0.1\n",
+          "--kappa=16.67\n", "--tau=75\n", "--seed=0\n", "--output=\"\"\n",
+          "--vertices=\"odometry\"\n"}) {
+      EXPECT_THAT(run.out, HasSubstr(flag));
+    }
+    // Not the logging library's flags, nor other commands' flags.
+    for (const char* other :
+         {"logtostderr", "minloglevel", "--v=", "--tum", "--components"}) {
+      EXPECT_THAT(run.out, Not(HasSubstr(other)));
+    }
+  }
+  const RunResult solve = RunToolWithOutput("solve --help");
+  EXPECT_EQ(solve.exit_code, 0);
+  for (const char* flag :
+       {"--components=false\n", "--progress=false\n", "--max_rank=10\n",
+        "--init=\"chordal\"\n", "--gradient_tolerance=1e-06\n"}) {
+    EXPECT_THAT(solve.out, HasSubstr(flag));
+  }
+  EXPECT_THAT(solve.out, Not(HasSubstr("--side")));
+  EXPECT_THAT(solve.out, Not(HasSubstr("logtostderr")));
+
+  const RunResult general = RunToolWithOutput("help");
+  EXPECT_EQ(general.exit_code, 0);
+  for (const char* command : kCommands) {
+    EXPECT_THAT(general.out, HasSubstr(std::string("\n  ") + command + " "));
+  }
+  EXPECT_EQ(RunToolWithOutput("help nosuchcommand").exit_code, 2);
+}
+
+TEST_F(CliTest, EveryFlagOfTheProgramIsListedByACommand) {
+  // gflags' XML lists every flag with the file that defines it.
+  const RunResult xml = RunToolWithOutput("--helpxml");
+  const std::regex flag("<flag><file>([^<]*)</file><name>([^<]*)</name>");
+  std::set<std::string> program_flags;
+  for (auto it = std::sregex_iterator(xml.out.begin(), xml.out.end(), flag);
+       it != std::sregex_iterator(); ++it) {
+    const std::string file = (*it)[1];
+    if (file.find("tools/") != std::string::npos) {
+      program_flags.insert((*it)[2]);
+    }
+  }
+  ASSERT_GE(program_flags.size(), 25u) << xml.out.substr(0, 2000);
+  std::string all_help;
+  for (const char* command : kCommands) {
+    all_help += RunToolWithOutput(std::string("help ") + command).out;
+  }
+  for (const std::string& name : program_flags) {
+    EXPECT_THAT(all_help, HasSubstr("\n  --" + name + "=")) << name;
+  }
+}
+
+TEST_F(CliTest, UnknownAndForeignFlagsAreUsageErrors) {
+  const std::string output = TempPath("flags.g2o");
+  RunResult run =
+      RunToolWithOutput("generate cube --bogus 1 --output " + output);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("unknown flag '--bogus'"));
+  run = RunToolWithOutput("generate cube --tum x.tum --output " + output);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("--tum is not a flag of this command"));
+  EXPECT_FALSE(fs::exists(output));
+  // Negated booleans and "--flag value" are flags too; glog's are accepted.
+  run = RunToolWithOutput("generate cube --side 3 --noverbose --v=0 --output " +
+                          output);
+  EXPECT_EQ(run.exit_code, 2) << run.output;  // --verbose is not generate's.
+  run = RunToolWithOutput("generate cube --side 3 --v=0 --output " + output);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::exists(output));
+  fs::remove(output);
+}
+
+// Two triangles (vertices 0-2 and 5-7): a disconnected graph.
+const char kTwoComponents[] =
+    "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n"
+    "EDGE_SE2 1 2 1 0 0.1 1 0 0 1 0 1\n"
+    "EDGE_SE2 2 0 -2 0.1 0 1 0 0 1 0 1\n"
+    "EDGE_SE2 5 6 1 0 0.5 1 0 0 1 0 1\n"
+    "EDGE_SE2 6 7 1 0 0 1 0 0 1 0 1\n"
+    "EDGE_SE2 7 5 1 1 0 1 0 0 1 0 1\n";
+
+TEST_F(CliTest, SolveComponents) {
+  const std::string graph = TempPath("two.g2o");
+  const std::string json_path = TempPath("two.json");
+  const std::string poses = TempPath("two_poses.g2o");
+  WriteText(graph, kTwoComponents);
+  RunResult run = RunToolWithOutput("solve " + graph + " --json " + json_path +
+                                    " --output " + poses);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err,
+              HasSubstr(graph + ":4: measurement graph is disconnected"));
+  EXPECT_THAT(run.err, HasSubstr("--components"));
+  EXPECT_FALSE(fs::exists(json_path));
+  EXPECT_FALSE(fs::exists(poses));
+
+  run = RunToolWithOutput("solve " + graph + " --components --json " +
+                          json_path + " --output " + poses);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.out, HasSubstr("Connected components"));
+  const std::string json = ReadText(json_path);
+  ASSERT_TRUE(IsValidJson(json)) << json;
+  EXPECT_THAT(json, HasSubstr("\"num_components\": 2"));
+  EXPECT_THAT(json, HasSubstr("\"vertex_ids\": [0, 1, 2]"));
+  EXPECT_THAT(json, HasSubstr("\"vertex_ids\": [5, 6, 7]"));
+  EXPECT_THAT(json, HasSubstr("\"gauge_vertex_id\": 5"));
+  EXPECT_THAT(json, HasSubstr("\"status\": \"CERTIFIED_OPTIMUM\""));
+  // The total is the sum of the components.
+  const double total = JsonNumber(json, "\"graph\"", "objective");
+  const double first = JsonNumber(json, "\"gauge_vertex_id\": 0", "objective");
+  const double second = JsonNumber(json, "\"gauge_vertex_id\": 5", "objective");
+  EXPECT_GT(first, 0);
+  EXPECT_GT(second, 0);
+  EXPECT_DOUBLE_EQ(total, first + second);
+  // All six poses; each component's first pose is its gauge (identity).
+  const std::string written = ReadText(poses);
+  EXPECT_THAT(written, HasSubstr("VERTEX_SE2 0 0 0 0\n"));
+  EXPECT_THAT(written, HasSubstr("VERTEX_SE2 5 0 0 0\n"));
+  for (const char* id : {"1 ", "2 ", "6 ", "7 "}) {
+    EXPECT_THAT(written, HasSubstr(std::string("VERTEX_SE2 ") + id));
+  }
+  for (const std::string& path : {graph, json_path, poses}) fs::remove(path);
+}
+
+TEST_F(CliTest, ProgressOnlyWhenAskedForOnAPipe) {
+  const std::string graph = TempPath("cube.g2o");
+  ASSERT_EQ(
+      RunToolWithOutput("generate cube --side 4 --output " + graph).exit_code,
+      0);
+  RunResult run = RunToolWithOutput("solve " + graph);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(run.err, "");  // stderr is not a terminal.
+  run = RunToolWithOutput("solve " + graph + " --noprogress");
+  EXPECT_EQ(run.err, "");
+  run = RunToolWithOutput("solve " + graph + " --progress");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  // One line per stage, in order.
+  size_t at = 0;
+  for (const char* stage : {"] data", "] initialize", "] optimize    rank 5",
+                            "] verify      rank 5", "] round", "] done"}) {
+    const size_t next = run.err.find(stage, at);
+    ASSERT_NE(next, std::string::npos) << stage << " in\n" << run.err;
+    at = next;
+  }
+  EXPECT_THAT(run.err, Not(HasSubstr("\r")));  // Plain lines on a pipe.
+  EXPECT_THAT(run.err, HasSubstr("F(x) "));
+  fs::remove(graph);
+}
+
+}  // namespace
+}  // namespace ceres_sesync
