@@ -153,9 +153,10 @@ std::string Certificate::BriefReport() const {
   char buf[512];
   std::snprintf(buf, sizeof(buf),
                 "Certificate: %s, F = %.10g, lower bound %.10g, relative "
-                "suboptimality <= %.3e, eta %.3e, %.3f s",
+                "suboptimality <= %.3e, eta %.3e (proof in %s), %.3f s",
                 certified ? "CERTIFIED" : "NOT CERTIFIED", objective,
-                lower_bound, relative_suboptimality_bound, eta, time_s);
+                lower_bound, relative_suboptimality_bound, eta,
+                proof_precision.c_str(), time_s);
   return buf;
 }
 

@@ -147,8 +147,14 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     }
     return result;
   };
+  double failed_double = 0;  // The largest shift a double proof failed at.
   auto prove = [&](double c, ProofPrecision precision) {
-    if (!matrix->Prove(Lambda, c, precision)) return false;
+    if (!matrix->Prove(Lambda, c, precision)) {
+      if (precision == ProofPrecision::kDouble) {
+        failed_double = std::max(failed_double, c);
+      }
+      return false;
+    }
     if (matrix->proven_shift() < result.eta) {
       result.eta = matrix->proven_shift();
       result.precision = precision;
@@ -199,9 +205,12 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       prove_extended();
     } else {
       // Double only: the strict proofs need shifts above what the
-      // translation shift mu costs; start just above the estimate of
-      // lambda_min(S) from the factor at eta_max and step up by 8.
-      double start = std::max(eta_target, std::numeric_limits<double>::min());
+      // translation shift mu costs and above those that failed already;
+      // start just above the estimate of lambda_min(S) from the factor at
+      // eta_max and step up by 8.
+      double start =
+          std::max({eta_target, 1.5 * double_floor, 2 * failed_double,
+                    std::numeric_limits<double>::min()});
       if (result.eta > eta_max) {  // The current factor is that at eta_max.
         ShiftInvertOperator op(matrix);
         const int dim = matrix->dimension();
