@@ -43,6 +43,40 @@
 // in the proof of Higham's Lemma 8.4 (Higham's Ch. 2 notes the same of the
 // model for arithmetic without a guard digit), so the Cholesky bound
 // gamma_{k+1} |L||L^T| holds with kDoubleDoubleUnitRoundoff.
+//
+// MultiplySubtract(s, x, y) (the inner loop of the supernodal factorization)
+// fuses the product into the subtraction, s - x y, in the same Cray-style
+// model with the product counted once:
+//
+//   fl(s - x y) = s (1 + alpha) - x y (1 + beta),
+//   |alpha| <= 3.01 u^2,  |beta| <= 13.01 u^2.
+//
+// With P = |x_hi y_hi| and normalized operands (|z_lo| <= u |z_hi|):
+// p = RN(x_hi y_hi) and p_e = x_hi y_hi - p (exact by an FMA, |p_e| <=
+// u |p|); a = RN(x_hi y_lo + p_e) and q = RN(x_lo y_hi + a) (two FMAs)
+// approximate p_e + x_hi y_lo + x_lo y_hi: |x_hi y_lo + p_e| <= (2u + u^2) P,
+// so q errs by <= u (2u + u^2) P + u (u + (1 + u)(2u + u^2)) P <= (5u^2 +
+// 5u^3) P, and |q| <= (3u + 7u^2) P; x_lo y_lo (<= u^2 P) is dropped.
+// (S, e) = TwoSum(s_hi, -p) is exact, |e| <= u |S| <= u (1 + u)(|s_hi| +
+// (1 + u) P). w = RN(s_lo - q) errs by <= u (|s_lo| + |q|) <= u^2 |s_hi| +
+// (3u^2 + 7u^3) P; t = RN(e + w) by <= u (|e| + |w|) <= (2u^2 + 2u^3) |s_hi|
+// + (4u^2 + 13u^3) P, using |w| <= (1 + u)(|s_lo| + |q|); the final
+// TwoSum(S, t) is exact (it renormalizes). S + t therefore differs from
+// s - x y by at most (3u^2 + 2u^3) |s_hi| + (13u^2 + 25u^3) P, and
+// |s_hi| <= |s| / (1 - u), P <= |x y| / (1 - u)^2 give the bounds above. In
+// the recursion of Lemma 8.4 every product now carries ONE factor (1 + beta)
+// where a multiplication and a subtraction carried two, so the Cholesky
+// bound gamma_{k+1} |L||L^T| holds a fortiori. A zero product (x or y zero)
+// leaves s unchanged exactly (up to the sign of zeros): p = p_e = a = q = 0,
+// e = 0, t = s_lo and TwoSum(s_hi, s_lo) = s for normalized s.
+//
+// Underflow (operands or products below 2^-969, where the low parts lose
+// bits): every rounding above obeys fl(z) = z (1 + delta) + eta with
+// |eta| <= 2^-1075, and eta != 0 only for the product and the three FMAs
+// (sums with a subnormal result are exact, so TwoSum stays exact); carried
+// through the derivation, MultiplySubtract errs by at most 4 (1 + u)^3
+// 2^-1075 < 2^-1070 absolutely beyond its model, the per-operation margin
+// extended_cholesky.cc adds.
 
 #ifndef CERES_SESYNC_INTERNAL_DOUBLE_DOUBLE_H_
 #define CERES_SESYNC_INTERNAL_DOUBLE_DOUBLE_H_
@@ -117,6 +151,48 @@ inline DoubleDouble AccumulateSubtract(const DoubleDouble& x,
                                        const DoubleDouble& y) {
   const DoubleDouble s = dd::TwoSum(x.hi, -y.hi);
   return dd::TwoSum(s.hi, s.lo + (x.lo - y.lo));
+}
+
+// The correctly rounded double operations, for MultiplySubtractParts.
+struct DoubleOps {
+  static double Add(double a, double b) { return a + b; }
+  static double Sub(double a, double b) { return a - b; }
+  static double Fma(double a, double b, double c) { return std::fma(a, b, c); }
+};
+
+// s - x y in the Cray-style model above (bound in the file comment), on the
+// parts of double-doubles. `Real` is double or a SIMD vector of doubles, with
+// Ops::Add, Sub and Fma the correctly rounded a + b, a - b and a b + c (lane
+// by lane; extended_cholesky.cc's kernels). Every type runs the same
+// operations in the same order, so results do not depend on the vector
+// width.
+template <class Ops, class Real>
+[[gnu::always_inline]] inline void MultiplySubtractParts(
+    Real s_hi, Real s_lo, Real x_hi, Real x_lo, Real y_hi, Real y_lo,
+    Real* r_hi, Real* r_lo) {
+  const Real p = x_hi * y_hi;
+  const Real p_e = Ops::Fma(x_hi, y_hi, -p);  // Exact: x_hi y_hi = p + p_e.
+  const Real a = Ops::Fma(x_hi, y_lo, p_e);
+  const Real q = Ops::Fma(x_lo, y_hi, a);
+  // (S, e) = TwoSum(s_hi, -p).
+  const Real S = Ops::Sub(s_hi, p);
+  const Real b = Ops::Sub(S, s_hi);
+  const Real e = Ops::Sub(Ops::Sub(s_hi, Ops::Sub(S, b)), Ops::Add(p, b));
+  const Real t = Ops::Add(e, Ops::Sub(s_lo, q));
+  // TwoSum(S, t).
+  const Real r = Ops::Add(S, t);
+  const Real c = Ops::Sub(r, S);
+  *r_lo = Ops::Add(Ops::Sub(S, Ops::Sub(r, c)), Ops::Sub(t, c));
+  *r_hi = r;
+}
+
+inline DoubleDouble MultiplySubtract(const DoubleDouble& s,
+                                     const DoubleDouble& x,
+                                     const DoubleDouble& y) {
+  DoubleDouble r;
+  MultiplySubtractParts<DoubleOps>(s.hi, s.lo, x.hi, x.lo, y.hi, y.lo, &r.hi,
+                                   &r.lo);
+  return r;
 }
 
 // Joldes-Muller-Popescu Algorithm 12 (DWTimesDW3).

@@ -1,7 +1,14 @@
+// The SIMD kernels pass GCC vector types between always-inlined functions
+// only; the ABI note about passing them by value does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
 #include "ceres_sesync/internal/extended_cholesky.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "glog/logging.h"
 
@@ -20,6 +27,8 @@ bool Safe(const DoubleDouble& x) {
   const double a = std::abs(x.hi);
   return a == 0 || (a >= kSmallestSafeValue && a <= kLargestSafeValue);
 }
+
+// ---- The simplicial reference ---------------------------------------------
 
 // The numerical phase, cloned for CPUs with and without FMA instructions (the
 // FMA is std::fma either way, so results are identical; the clone only makes
@@ -78,7 +87,213 @@ __attribute__((target_clones("fma", "default"))) bool FactorizeRows(
   return true;
 }
 
+// ---- Dense kernels of the supernodal factorization ------------------------
+//
+// Double-double matrices are stored as two column-major arrays of doubles
+// (high and low parts) with a common leading dimension, so that W
+// consecutive rows load as one W-lane vector. Every kernel applies
+// MultiplySubtract to each entry over the inner index in increasing order;
+// the lanes of a vector are independent entries, so the vectorized and the
+// portable instantiations compute bitwise the same results.
+
+// Lanes: the portable scalar, and 4 doubles (AVX2) as a GCC/Clang vector
+// type, with the operations MultiplySubtractParts takes.
+struct ScalarLanes : DoubleOps {
+  using Real = double;
+  static constexpr int kWidth = 1;
+  [[gnu::always_inline]] static Real Load(const double* p) { return *p; }
+  [[gnu::always_inline]] static void Store(double* p, Real v) { *p = v; }
+  [[gnu::always_inline]] static Real Broadcast(double x) { return x; }
+};
+
+typedef double Vector4 __attribute__((vector_size(32)));
+
+struct Lanes4 {
+  using Real = Vector4;
+  static constexpr int kWidth = 4;
+  [[gnu::always_inline]] static Real Load(const double* p) {
+    Real v;
+    std::memcpy(&v, p, sizeof(v));
+    return v;
+  }
+  [[gnu::always_inline]] static void Store(double* p, Real v) {
+    std::memcpy(p, &v, sizeof(v));
+  }
+  [[gnu::always_inline]] static Real Broadcast(double x) {
+    return Real{x, x, x, x};
+  }
+  // Lane by lane; compiles to one vfmadd with FMA enabled.
+  [[gnu::always_inline]] static Real Fma(Real a, Real b, Real c) {
+    Real r;
+    for (int i = 0; i < kWidth; ++i) r[i] = std::fma(a[i], b[i], c[i]);
+    return r;
+  }
+  [[gnu::always_inline]] static Real Add(Real a, Real b) { return a + b; }
+  [[gnu::always_inline]] static Real Sub(Real a, Real b) { return a - b; }
+};
+
+// C(i, j) <- C(i, j) - sum_l A(i, l) B(j, l), l = 0 .. k-1 in order, for the
+// lower trapezoid 0 <= j < n, j <= i < m (m >= n): row i of A and of C and
+// row j of B are the same local index space, as for the rows of a supernode.
+struct UpdateBlock {
+  const double *a_hi, *a_lo;
+  int lda;
+  const double *b_hi, *b_lo;
+  int ldb;
+  double *c_hi, *c_lo;
+  int ldc;
+  int m, n, k;
+};
+
+template <class Lanes>
+[[gnu::always_inline]] inline void Step(double* c_hi, double* c_lo,
+                                        typename Lanes::Real x_hi,
+                                        typename Lanes::Real x_lo,
+                                        typename Lanes::Real y_hi,
+                                        typename Lanes::Real y_lo) {
+  typename Lanes::Real r_hi, r_lo;
+  MultiplySubtractParts<Lanes>(Lanes::Load(c_hi), Lanes::Load(c_lo), x_hi,
+                               x_lo, y_hi, y_lo, &r_hi, &r_lo);
+  Lanes::Store(c_hi, r_hi);
+  Lanes::Store(c_lo, r_lo);
+}
+
+// Rows are processed in chunks that stay in the L1 cache across l.
+constexpr int kRowChunk = 128;
+constexpr int kColumnBlock = 4;
+
+// Columns j0 .. j0 + kColumns - 1 of the update.
+template <class Lanes, int kColumns>
+[[gnu::always_inline]] inline void UpdateColumns(const UpdateBlock& u,
+                                                 int j0) {
+  using Real = typename Lanes::Real;
+  constexpr int W = Lanes::kWidth;
+  const int lda = u.lda, ldb = u.ldb, ldc = u.ldc;
+  // The triangle i < j0 + kColumns (scalar).
+  const int corner = std::min(u.m, j0 + kColumns);
+  for (int l = 0; l < u.k; ++l) {
+    for (int jj = 0; jj < kColumns; ++jj) {
+      const int j = j0 + jj;
+      const double y_hi = u.b_hi[j + l * ldb], y_lo = u.b_lo[j + l * ldb];
+      for (int i = j; i < corner; ++i) {
+        Step<ScalarLanes>(u.c_hi + i + j * ldc, u.c_lo + i + j * ldc,
+                          u.a_hi[i + l * lda], u.a_lo[i + l * lda], y_hi, y_lo);
+      }
+    }
+  }
+  for (int i0 = corner; i0 < u.m; i0 += kRowChunk) {
+    const int i1 = std::min(u.m, i0 + kRowChunk);
+    for (int l = 0; l < u.k; ++l) {
+      Real y_hi[kColumns], y_lo[kColumns];
+      for (int jj = 0; jj < kColumns; ++jj) {
+        y_hi[jj] = Lanes::Broadcast(u.b_hi[j0 + jj + l * ldb]);
+        y_lo[jj] = Lanes::Broadcast(u.b_lo[j0 + jj + l * ldb]);
+      }
+      const double* a_hi = u.a_hi + l * lda;
+      const double* a_lo = u.a_lo + l * lda;
+      double* c_hi = u.c_hi + j0 * ldc;
+      double* c_lo = u.c_lo + j0 * ldc;
+      int i = i0;
+      for (; i + W <= i1; i += W) {
+        const Real x_hi = Lanes::Load(a_hi + i), x_lo = Lanes::Load(a_lo + i);
+        for (int jj = 0; jj < kColumns; ++jj) {
+          Step<Lanes>(c_hi + i + jj * ldc, c_lo + i + jj * ldc, x_hi, x_lo,
+                      y_hi[jj], y_lo[jj]);
+        }
+      }
+      for (; i < i1; ++i) {
+        for (int jj = 0; jj < kColumns; ++jj) {
+          Step<ScalarLanes>(c_hi + i + jj * ldc, c_lo + i + jj * ldc, a_hi[i],
+                            a_lo[i], u.b_hi[j0 + jj + l * ldb],
+                            u.b_lo[j0 + jj + l * ldb]);
+        }
+      }
+    }
+  }
+}
+
+template <class Lanes>
+[[gnu::always_inline]] inline void Update(const UpdateBlock& u) {
+  for (int j0 = 0; j0 < u.n; j0 += kColumnBlock) {
+    switch (std::min(kColumnBlock, u.n - j0)) {
+      case 4:
+        UpdateColumns<Lanes, 4>(u, j0);
+        break;
+      case 3:
+        UpdateColumns<Lanes, 3>(u, j0);
+        break;
+      case 2:
+        UpdateColumns<Lanes, 2>(u, j0);
+        break;
+      default:
+        UpdateColumns<Lanes, 1>(u, j0);
+    }
+  }
+}
+
+void UpdatePortable(const UpdateBlock& u) { Update<ScalarLanes>(u); }
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx2,fma"))) void UpdateAvx2(const UpdateBlock& u) {
+  Update<Lanes4>(u);
+}
+bool HaveAvx2() {
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+#else
+void UpdateAvx2(const UpdateBlock& u) { UpdatePortable(u); }
+bool HaveAvx2() { return false; }
+#endif
+
+using UpdateFunction = void (*)(const UpdateBlock&);
+
+// Factors one supernode in place after all updates from below: its nrows x
+// ncols block X (column-major, leading dimension nrows, hi/lo parts), with
+// the diagonal block on top. Panels of kPanel columns: each panel first
+// receives the update of the supernode's earlier columns (one large
+// Update), then its columns are finished one by one (the update of the
+// panel's earlier columns, the pivot, the scaling). Returns false on a pivot
+// that is not positive or not safe.
+constexpr int kPanel = 32;
+
+bool FactorSupernode(UpdateFunction update, int nrows, int ncols, double* hi,
+                     double* lo) {
+  const int ld = nrows;
+  for (int c0 = 0; c0 < ncols; c0 += kPanel) {
+    const int c1 = std::min(ncols, c0 + kPanel);
+    if (c0 > 0) {
+      update({hi + c0, lo + c0, ld, hi + c0, lo + c0, ld, hi + c0 + c0 * ld,
+              lo + c0 + c0 * ld, ld, nrows - c0, c1 - c0, c0});
+    }
+    for (int j = c0; j < c1; ++j) {
+      double* x_hi = hi + j * ld;
+      double* x_lo = lo + j * ld;
+      if (j > c0) {
+        update({hi + j + c0 * ld, lo + j + c0 * ld, ld, hi + j + c0 * ld,
+                lo + j + c0 * ld, ld, x_hi + j, x_lo + j, ld, nrows - j, 1,
+                j - c0});
+      }
+      const DoubleDouble d(x_hi[j], x_lo[j]);
+      if (!(d.hi > 0) || !Safe(d)) return false;
+      const DoubleDouble l_jj = Sqrt(d);
+      const DoubleDouble inverse = Reciprocal(l_jj);
+      x_hi[j] = l_jj.hi;
+      x_lo[j] = l_jj.lo;
+      for (int i = j + 1; i < nrows; ++i) {
+        const DoubleDouble l_ij = DoubleDouble(x_hi[i], x_lo[i]) * inverse;
+        x_hi[i] = l_ij.hi;
+        x_lo[i] = l_ij.lo;
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+DoubleDoubleCholesky::DoubleDoubleCholesky(const Options& options)
+    : options_(options),
+      vectorized_(options.supernodal && options.vectorize && HaveAvx2()) {}
 
 void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
                                    std::vector<int> row_index) {
@@ -122,12 +337,206 @@ void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
   factor_row_.resize(factor_start_[n]);
   factor_value_.resize(factor_start_[n]);
   factorized_ = false;
+  super_start_.clear();
+  super_row_start_.clear();
+  super_row_.clear();
+  super_value_start_.clear();
+  if (options_.supernodal) AnalyzeSupernodes();
+}
+
+void DoubleDoubleCholesky::AnalyzeSupernodes() {
+  const int n = n_;
+  // The pattern of L by columns (rows increasing, diagonal first), by the
+  // same up-looking pass as the simplicial factorization.
+  {
+    std::vector<int> next(factor_start_.begin(), factor_start_.end() - 1);
+    std::vector<int> mark(n, -1);
+    for (int k = 0; k < n; ++k) {
+      factor_row_[next[k]++] = k;
+      mark[k] = k;
+      for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
+        for (int i = row_index_[p]; mark[i] != k; i = parent_[i]) {
+          mark[i] = k;
+          factor_row_[next[i]++] = k;
+        }
+      }
+    }
+  }
+  // Fundamental supernodes: column j + 1 continues column j's supernode iff
+  // it is j's parent and has j's pattern minus j.
+  auto count = [&](int j) { return factor_start_[j + 1] - factor_start_[j]; };
+  super_start_.push_back(0);
+  for (int j = 1; j < n; ++j) {
+    if (!(parent_[j - 1] == j && count(j - 1) == count(j) + 1)) {
+      super_start_.push_back(j);
+    }
+  }
+  if (n > 0) super_start_.push_back(n);
+  const int num_super = num_supernodes();
+  column_super_.resize(n);
+  super_row_start_.assign(1, 0);
+  super_value_start_.assign(1, 0);
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s];
+    const int ncols = super_start_[s + 1] - first;
+    for (int j = first; j < first + ncols; ++j) column_super_[j] = s;
+    super_row_.insert(super_row_.end(), factor_row_.begin() + factor_start_[first],
+                      factor_row_.begin() + factor_start_[first + 1]);
+    super_row_start_.push_back(static_cast<int>(super_row_.size()));
+    const long long nrows = count(first);
+    super_value_start_.push_back(super_value_start_.back() + nrows * ncols);
+  }
+  // Where each input value goes: entry (k, i), k >= i, of A is in the column
+  // of supernode s = column_super_[i], at the position of row k.
+  value_destination_.assign(row_index_.size(), -1);
+  std::vector<int> lower_start(n + 1, 0);
+  for (int k = 0; k < n; ++k) {
+    for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
+      ++lower_start[row_index_[p] + 1];
+    }
+  }
+  for (int i = 0; i < n; ++i) lower_start[i + 1] += lower_start[i];
+  std::vector<int> lower_row(row_index_.size()), lower_value(row_index_.size());
+  {
+    std::vector<int> next(lower_start.begin(), lower_start.end() - 1);
+    for (int k = 0; k < n; ++k) {
+      for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
+        const int slot = next[row_index_[p]]++;
+        lower_row[slot] = k;
+        lower_value[slot] = p;
+      }
+    }
+  }
+  std::vector<int> position(n, -1);
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s];
+    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const int* rows = super_row_.data() + super_row_start_[s];
+    for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
+    for (int j = first; j < super_start_[s + 1]; ++j) {
+      for (int q = lower_start[j]; q < lower_start[j + 1]; ++q) {
+        value_destination_[lower_value[q]] =
+            super_value_start_[s] + static_cast<long long>(j - first) * nrows +
+            position[lower_row[q]];
+      }
+    }
+  }
+}
+
+bool DoubleDoubleCholesky::FactorizeSupernodal(
+    const std::vector<DoubleDouble>& values) {
+  const int num_super = num_supernodes();
+  const UpdateFunction update = vectorized_ ? UpdateAvx2 : UpdatePortable;
+  super_hi_.assign(supernodal_entries(), 0.0);
+  super_lo_.assign(supernodal_entries(), 0.0);
+  for (size_t p = 0; p < values.size(); ++p) {
+    // Renormalized (the same value): the kernels' bounds assume it.
+    const DoubleDouble v = dd::TwoSum(values[p].hi, values[p].lo);
+    super_hi_[value_destination_[p]] = v.hi;
+    super_lo_[value_destination_[p]] = v.lo;
+  }
+  // Left-looking: supernode d, once factored, waits in the list of the
+  // supernode holding its next row below the ones already applied
+  // (pointer[d]), which it updates when that one's turn comes.
+  std::vector<int> head(num_super, -1), next(num_super, -1);
+  std::vector<int> pointer(num_super, 0), position(n_, -1);
+  std::vector<int> relative;
+  std::vector<double> work_hi, work_lo;
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s], last = super_start_[s + 1];
+    const int ncols = last - first;
+    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const int* rows = super_row_.data() + super_row_start_[s];
+    double* s_hi = super_hi_.data() + super_value_start_[s];
+    double* s_lo = super_lo_.data() + super_value_start_[s];
+    for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
+    for (int d = head[s]; d != -1;) {
+      const int d_next = next[d];
+      const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
+      const int* d_rows = super_row_.data() + super_row_start_[d];
+      const int p1 = pointer[d];
+      int p2 = p1;
+      while (p2 < d_nrows && d_rows[p2] < last) ++p2;
+      const int m = d_nrows - p1, n = p2 - p1;
+      const double* d_hi = super_hi_.data() + super_value_start_[d] + p1;
+      const double* d_lo = super_lo_.data() + super_value_start_[d] + p1;
+      const int k = super_start_[d + 1] - super_start_[d];
+      // The target rows of d's rows p1.. are contiguous in s (positions
+      // increase with the rows): update s in place; otherwise gather the
+      // target entries, update, scatter.
+      const int r0 = position[d_rows[p1]];
+      if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
+        update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                s_hi + r0 + static_cast<long long>(r0) * nrows,
+                s_lo + r0 + static_cast<long long>(r0) * nrows, nrows, m, n,
+                k});
+      } else {
+        relative.resize(m);
+        for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
+        const size_t size = static_cast<size_t>(m) * n;
+        if (work_hi.size() < size) {
+          work_hi.resize(size);
+          work_lo.resize(size);
+        }
+        for (int j = 0; j < n; ++j) {
+          const long long column = static_cast<long long>(relative[j]) * nrows;
+          for (int i = j; i < m; ++i) {
+            work_hi[i + j * m] = s_hi[column + relative[i]];
+            work_lo[i + j * m] = s_lo[column + relative[i]];
+          }
+        }
+        update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows, work_hi.data(),
+                work_lo.data(), m, m, n, k});
+        for (int j = 0; j < n; ++j) {
+          const long long column = static_cast<long long>(relative[j]) * nrows;
+          for (int i = j; i < m; ++i) {
+            s_hi[column + relative[i]] = work_hi[i + j * m];
+            s_lo[column + relative[i]] = work_lo[i + j * m];
+          }
+        }
+      }
+      pointer[d] = p2;
+      if (p2 < d_nrows) {
+        const int target = column_super_[d_rows[p2]];
+        next[d] = head[target];
+        head[target] = d;
+      }
+      d = d_next;
+    }
+    if (!FactorSupernode(update, nrows, ncols, s_hi, s_lo)) return false;
+    pointer[s] = ncols;
+    if (ncols < nrows) {
+      const int target = column_super_[rows[ncols]];
+      next[s] = head[target];
+      head[target] = s;
+    }
+  }
+  // L in compressed columns.
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s];
+    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const double* s_hi = super_hi_.data() + super_value_start_[s];
+    const double* s_lo = super_lo_.data() + super_value_start_[s];
+    for (int j = first; j < super_start_[s + 1]; ++j) {
+      const long long offset = static_cast<long long>(j - first) * nrows +
+                               (j - first);
+      for (int p = factor_start_[j]; p < factor_start_[j + 1]; ++p) {
+        const long long t = offset + (p - factor_start_[j]);
+        factor_value_[p] = DoubleDouble(s_hi[t], s_lo[t]);
+      }
+    }
+  }
+  return true;
 }
 
 bool DoubleDoubleCholesky::Factorize(const std::vector<DoubleDouble>& values) {
   CHECK_EQ(values.size(), row_index_.size());
   for (const DoubleDouble& v : values) {
     if (!Safe(v)) return factorized_ = false;
+  }
+  if (options_.supernodal) {
+    factorized_ = FactorizeSupernodal(values);
+    return factorized_;
   }
   std::vector<int> fill(n_);
   factorized_ =
