@@ -5,11 +5,12 @@
 //   extended_cholesky_bench [--repeats N] [--simplicial] [--portable]
 //                           [--cholmod] GRAPH.g2o...
 //
-// Times are CPU seconds (the machine may be shared). Per graph: K = [Lbar, -Vbar; -Vbar^T, D + I] (the certificate matrix K_c
-// of internal/certificate_matrix.h with Lambda = 0, c = 1: positive
-// definite), in the block ordering the certificate uses (the problem's
-// vertex ordering, each vertex expanded into its unknowns), and in
-// double-double (the doubles exactly). Times (seconds, minimum over
+// Times are CPU seconds (the machine may be shared). Per graph: K = [Lbar,
+// -Vbar; -Vbar^T, D + I] (the certificate matrix K_c of
+// internal/certificate_matrix.h with Lambda = 0, c = 1: positive definite), in
+// the block ordering the certificate uses (the problem's vertex ordering, each
+// vertex expanded into its unknowns), and in double-double (the doubles
+// exactly). Times (seconds, minimum over
 // --repeats runs: the machine is shared) of Factorize() for
 //  - supernodal: the default (SIMD kernels when the CPU has AVX2+FMA);
 //  - portable (--portable): the same without SIMD (bitwise the same factor);
@@ -25,9 +26,9 @@
 //   ceres_sesync generate cube --side 20 --output /tmp/cube20.g2o
 
 #include <algorithm>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -151,8 +152,8 @@ double FactorDifference(const DoubleDoubleCholesky& a,
     for (int p = a.factor_start()[c]; p < a.factor_start()[c + 1]; ++p) {
       CHECK_EQ(a.factor_row()[p], b.factor_row()[p]);
       const DoubleDouble diff = a.factor_value()[p] - b.factor_value()[p];
-      worst = std::max(worst, std::abs(diff.ToDouble()) /
-                                  row_max[a.factor_row()[p]]);
+      worst = std::max(worst,
+                       std::abs(diff.ToDouble()) / row_max[a.factor_row()[p]]);
     }
   }
   return worst;
@@ -179,12 +180,13 @@ void RunDense(int n) {
     start[j + 1] = static_cast<int>(row.size());
   }
   DoubleDoubleCholesky chol;
-  const Timing t = TimeDoubleDouble(&chol, n, start, row, values,
-                                    FLAGS_repeats);
-  std::printf("dense %d: multiply-adds %.3g, factorize %.3f s (%.2f ns per "
-              "multiply-add), SIMD %s\n",
-              n, chol.flops(), t.factorize, 1e9 * t.factorize / chol.flops(),
-              chol.vectorized() ? "yes" : "no");
+  const Timing t =
+      TimeDoubleDouble(&chol, n, start, row, values, FLAGS_repeats);
+  std::printf(
+      "dense %d: multiply-adds %.3g, factorize %.3f s (%.2f ns per "
+      "multiply-add), SIMD %s\n",
+      n, chol.flops(), t.factorize, 1e9 * t.factorize / chol.flops(),
+      chol.vectorized() ? "yes" : "no");
 }
 
 void Run(const std::string& path) {
@@ -237,9 +239,10 @@ void Run(const std::string& path) {
           static_cast<double>(supernodal.factor_nonzeros()),
       supernodal.vectorized() ? "yes" : "no");
   auto report = [&](const char* name, const Timing& t) {
-    std::printf("  %-22s analyze %8.3f s  factorize %8.3f s  (%.2f ns per "
-                "multiply-add)\n",
-                name, t.analyze, t.factorize, 1e9 * t.factorize / flops);
+    std::printf(
+        "  %-22s analyze %8.3f s  factorize %8.3f s  (%.2f ns per "
+        "multiply-add)\n",
+        name, t.analyze, t.factorize, 1e9 * t.factorize / flops);
   };
   report("double-double supernodal", t_super);
   if (FLAGS_portable) {
@@ -257,10 +260,11 @@ void Run(const std::string& path) {
     DoubleDoubleCholesky simplicial(options);
     const Timing t = TimeDoubleDouble(&simplicial, size, start, row, values, 1);
     report("double-double simplicial", t);
-    std::printf("    speed-up %.2fx, max difference %.3g (relative to the "
-                "row's largest entry)\n",
-                t.factorize / t_super.factorize,
-                FactorDifference(simplicial, supernodal));
+    std::printf(
+        "    speed-up %.2fx, max difference %.3g (relative to the "
+        "row's largest entry)\n",
+        t.factorize / t_super.factorize,
+        FactorDifference(simplicial, supernodal));
   }
   if (FLAGS_cholmod) {
     internal::CholmodFactor factor;

@@ -44,38 +44,55 @@
 // model for arithmetic without a guard digit), so the Cholesky bound
 // gamma_{k+1} |L||L^T| holds with kDoubleDoubleUnitRoundoff.
 //
-// MultiplySubtract(s, x, y) (the inner loop of the supernodal factorization)
-// fuses the product into the subtraction, s - x y, in the same Cray-style
-// model with the product counted once:
+// SubtractProducts(s, x, y, K) (the inner loop of the supernodal
+// factorization) computes s - sum_{j=1..K} x_j y_j for K <= kMaxProducts
+// with ONE renormalization: the high parts T_j accumulate exactly by TwoSum,
+// the low parts t_j (errors and low products) in double, and TwoSum(T_K,
+// t_K) at the end. It satisfies the Cray-style model with the products
+// fused:
 //
-//   fl(s - x y) = s (1 + alpha) - x y (1 + beta),
-//   |alpha| <= 3.01 u^2,  |beta| <= 13.01 u^2.
+//   fl(s - sum_j x_j y_j) = s (1 + alpha) - sum_j x_j y_j (1 + beta_j),
+//   |alpha| <= (K^2 + 2K) u^2 (1 + 40u),
+//   |beta_j| <= (n_j^2 + 6 n_j + 6) u^2 (1 + 40u),  n_j = K - j + 1
 //
-// With P = |x_hi y_hi| and normalized operands (|z_lo| <= u |z_hi|):
-// p = RN(x_hi y_hi) and p_e = x_hi y_hi - p (exact by an FMA, |p_e| <=
-// u |p|); a = RN(x_hi y_lo + p_e) and q = RN(x_lo y_hi + a) (two FMAs)
-// approximate p_e + x_hi y_lo + x_lo y_hi: |x_hi y_lo + p_e| <= (2u + u^2) P,
-// so q errs by <= u (2u + u^2) P + u (u + (1 + u)(2u + u^2)) P <= (5u^2 +
-// 5u^3) P, and |q| <= (3u + 7u^2) P; x_lo y_lo (<= u^2 P) is dropped.
-// (S, e) = TwoSum(s_hi, -p) is exact, |e| <= u |S| <= u (1 + u)(|s_hi| +
-// (1 + u) P). w = RN(s_lo - q) errs by <= u (|s_lo| + |q|) <= u^2 |s_hi| +
-// (3u^2 + 7u^3) P; t = RN(e + w) by <= u (|e| + |w|) <= (2u^2 + 2u^3) |s_hi|
-// + (4u^2 + 13u^3) P, using |w| <= (1 + u)(|s_lo| + |q|); the final
-// TwoSum(S, t) is exact (it renormalizes). S + t therefore differs from
-// s - x y by at most (3u^2 + 2u^3) |s_hi| + (13u^2 + 25u^3) P, and
-// |s_hi| <= |s| / (1 - u), P <= |x y| / (1 - u)^2 give the bounds above. In
-// the recursion of Lemma 8.4 every product now carries ONE factor (1 + beta)
-// where a multiplication and a subtraction carried two, so the Cholesky
-// bound gamma_{k+1} |L||L^T| holds a fortiori. A zero product (x or y zero)
-// leaves s unchanged exactly (up to the sign of zeros): p = p_e = a = q = 0,
-// e = 0, t = s_lo and TwoSum(s_hi, s_lo) = s for normalized s.
+// (n_j: the steps from product j to the end; K = 1: 3.01 u^2 and 13.01 u^2).
+// Since K^2 + 2K <= 32 K and n^2 + 6n + 6 <= 32 n for 1 <= n <= 25, this is
+// at most what K steps of the Cray model with kDoubleDoubleUnitRoundoff give
+// the accumulator (K factors) and product j (n_j factors), so in the
+// recursion of Lemma 8.4 (with Higham's Lemma 3.3, (1 + theta_a)(1 +
+// theta_b) = 1 + theta_{a+b}) every term of an entry still carries at most
+// theta_m for m the products from it to the end: the Cholesky bound
+// gamma_{k+1} |L||L^T| holds unchanged, whatever the blocking.
+//
+// Derivation (normalized operands, |z_lo| <= u |z_hi|, P_j = |x_j,hi
+// y_j,hi|, m_j = |s_hi| + sum_{i<=j} P_i). Step j: p_j = RN(x_hi y_hi);
+// p_e = x_hi y_hi - p_j exactly by an FMA, |p_e| <= u P_j; a = RN(x_hi y_lo +
+// p_e) (FMA, error <= 2u^2 P_j, |a| <= 2u (1 + u) P_j); q_j = RN(x_lo y_hi +
+// a) (FMA, error <= (3u^2 + 2u^3) P_j, |q_j| <= (3u + 6u^2) P_j), so q_j is
+// within (5u^2 + 2u^3) P_j of Q_j = p_e + x_hi y_lo + x_lo y_hi, and x_lo y_lo
+// (<= u^2 P_j) is dropped. (T_j, e_j) = TwoSum(T_{j-1}, -p_j) is exact with
+// |e_j| <= u |T_j| <= u (1 + 10u) m_j (T_0 = s_hi; |T_j| <= (1 + u)^{j+1}
+// m_j). w_j = RN(t_{j-1} - q_j) and t_j = RN(e_j + w_j) (t_0 = s_lo) err by
+// at most u (2 + u)(|t_{j-1}| + |q_j|) + u |e_j| together. Unrolling,
+// r = T_K + t_K = s - sum_j (p_j + q_j) + sum_j (roundings of w_j, t_j), so
+//   |r - (s - sum_j x_j y_j)| <= sum_j (6u^2 + 2u^3) P_j
+//                                + sum_j (roundings of w_j and t_j),
+// and |t_{j-1}| <= (1 + 28u) tau_{j-1} with tau_{j-1} = u (|s_hi| +
+// sum_{i<j} (3 P_i + m_i)) = u (j |s_hi| + sum_{i<j} (3 + j - i) P_i). Step
+// j's roundings are therefore at most u^2 (1 + 32u) ((2j + 1) |s_hi| +
+// sum_{i<=j} (7 + 2 (j - i)) P_i); summed over j = 1..K, |s_hi| collects
+// K^2 + 2K and P_i collects sum_{j=i..K} (7 + 2 (j - i)) = n_i^2 + 6 n_i.
+// With |s_hi| <= |s| / (1 - u) and P_j <= |x_j y_j| / (1 - u)^2 the bounds
+// above follow (the (1 + 40u) covers every second-order factor for
+// K <= 8). A zero product (x or y zero) is an exact no-op on (T, t) (p =
+// p_e = a = q = 0, e = 0), so explicit zeros change no result.
 //
 // Underflow (operands or products below 2^-969, where the low parts lose
 // bits): every rounding above obeys fl(z) = z (1 + delta) + eta with
-// |eta| <= 2^-1075, and eta != 0 only for the product and the three FMAs
-// (sums with a subnormal result are exact, so TwoSum stays exact); carried
-// through the derivation, MultiplySubtract errs by at most 4 (1 + u)^3
-// 2^-1075 < 2^-1070 absolutely beyond its model, the per-operation margin
+// |eta| <= 2^-1075, and eta != 0 only for the product and the three FMAs of
+// a step (sums with a subnormal result are exact, so TwoSum stays exact);
+// carried through the derivation, each step errs by at most 4 (1 + u)^2K
+// 2^-1075 < 2^-1070 absolutely beyond the model, the per-operation margin
 // extended_cholesky.cc adds.
 
 #ifndef CERES_SESYNC_INTERNAL_DOUBLE_DOUBLE_H_
@@ -153,46 +170,66 @@ inline DoubleDouble AccumulateSubtract(const DoubleDouble& x,
   return dd::TwoSum(s.hi, s.lo + (x.lo - y.lo));
 }
 
-// The correctly rounded double operations, for MultiplySubtractParts.
+// The correctly rounded double operations, for the *Parts functions below.
+// FmaAdd and FmaSub are a + b and a - b as well (rounded once: RN(a 1 + b) =
+// RN(a + b)), which SIMD code may compute with FMA instructions to use both
+// kinds of floating-point units.
 struct DoubleOps {
   static double Add(double a, double b) { return a + b; }
   static double Sub(double a, double b) { return a - b; }
+  static double FmaAdd(double a, double b) { return a + b; }
+  static double FmaSub(double a, double b) { return a - b; }
   static double Fma(double a, double b, double c) { return std::fma(a, b, c); }
 };
 
-// s - x y in the Cray-style model above (bound in the file comment), on the
-// parts of double-doubles. `Real` is double or a SIMD vector of doubles, with
+// The steps of SubtractProducts (bound in the file comment) on the parts of
+// double-doubles. `Real` is double or a SIMD vector of doubles, with
 // Ops::Add, Sub and Fma the correctly rounded a + b, a - b and a b + c (lane
-// by lane; extended_cholesky.cc's kernels). Every type runs the same
+// by lane: extended_cholesky.cc's kernels; FmaAdd and FmaSub likewise). Every
+// type runs the same
 // operations in the same order, so results do not depend on the vector
 // width.
+//
+// One step: (T, t) <- (T, t) - x y, with (T, t) not renormalized.
 template <class Ops, class Real>
-[[gnu::always_inline]] inline void MultiplySubtractParts(
-    Real s_hi, Real s_lo, Real x_hi, Real x_lo, Real y_hi, Real y_lo,
-    Real* r_hi, Real* r_lo) {
+[[gnu::always_inline]] inline void SubtractProductParts(Real x_hi, Real x_lo,
+                                                        Real y_hi, Real y_lo,
+                                                        Real* T, Real* t) {
   const Real p = x_hi * y_hi;
   const Real p_e = Ops::Fma(x_hi, y_hi, -p);  // Exact: x_hi y_hi = p + p_e.
   const Real a = Ops::Fma(x_hi, y_lo, p_e);
   const Real q = Ops::Fma(x_lo, y_hi, a);
-  // (S, e) = TwoSum(s_hi, -p).
-  const Real S = Ops::Sub(s_hi, p);
-  const Real b = Ops::Sub(S, s_hi);
-  const Real e = Ops::Sub(Ops::Sub(s_hi, Ops::Sub(S, b)), Ops::Add(p, b));
-  const Real t = Ops::Add(e, Ops::Sub(s_lo, q));
-  // TwoSum(S, t).
-  const Real r = Ops::Add(S, t);
-  const Real c = Ops::Sub(r, S);
-  *r_lo = Ops::Add(Ops::Sub(S, Ops::Sub(r, c)), Ops::Sub(t, c));
-  *r_hi = r;
+  // (S, e) = TwoSum(T, -p).
+  const Real S = Ops::Sub(*T, p);
+  const Real b = Ops::Sub(S, *T);
+  const Real e = Ops::Sub(Ops::FmaSub(*T, Ops::Sub(S, b)), Ops::FmaAdd(p, b));
+  *t = Ops::Add(e, Ops::Sub(*t, q));
+  *T = S;
 }
 
-inline DoubleDouble MultiplySubtract(const DoubleDouble& s,
-                                     const DoubleDouble& x,
-                                     const DoubleDouble& y) {
-  DoubleDouble r;
-  MultiplySubtractParts<DoubleOps>(s.hi, s.lo, x.hi, x.lo, y.hi, y.lo, &r.hi,
-                                   &r.lo);
-  return r;
+// (T, t) <- TwoSum(T, t): the normalized double-double T + t.
+template <class Ops, class Real>
+[[gnu::always_inline]] inline void RenormalizeParts(Real* T, Real* t) {
+  const Real r = Ops::Add(*T, *t);
+  const Real c = Ops::Sub(r, *T);
+  *t = Ops::Add(Ops::Sub(*T, Ops::Sub(r, c)), Ops::Sub(*t, c));
+  *T = r;
+}
+
+// The largest number of products SubtractProducts' bound covers.
+constexpr int kMaxProducts = 8;
+
+// s - sum_{j<count} x[j] y[j] with one renormalization, count <=
+// kMaxProducts (bound in the file comment).
+inline DoubleDouble SubtractProducts(const DoubleDouble& s,
+                                     const DoubleDouble* x,
+                                     const DoubleDouble* y, int count) {
+  double T = s.hi, t = s.lo;
+  for (int j = 0; j < count; ++j) {
+    SubtractProductParts<DoubleOps>(x[j].hi, x[j].lo, y[j].hi, y[j].lo, &T, &t);
+  }
+  RenormalizeParts<DoubleOps>(&T, &t);
+  return {T, t};
 }
 
 // Joldes-Muller-Popescu Algorithm 12 (DWTimesDW3).

@@ -10,6 +10,10 @@
 #include <cmath>
 #include <cstring>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
@@ -96,16 +100,18 @@ __attribute__((target_clones("fma", "default"))) bool FactorizeRows(
 // the lanes of a vector are independent entries, so the vectorized and the
 // portable instantiations compute bitwise the same results.
 
-// Lanes: the portable scalar, and 4 doubles (AVX2) as a GCC/Clang vector
-// type, with the operations MultiplySubtractParts takes.
+// Lanes: the portable scalar, and 4 doubles (AVX2), with the operations
+// SubtractProductParts takes.
 struct ScalarLanes : DoubleOps {
   using Real = double;
   static constexpr int kWidth = 1;
   [[gnu::always_inline]] static Real Load(const double* p) { return *p; }
   [[gnu::always_inline]] static void Store(double* p, Real v) { *p = v; }
-  [[gnu::always_inline]] static Real Broadcast(double x) { return x; }
+  [[gnu::always_inline]] static Real Broadcast(const double* p) { return *p; }
 };
 
+// 4 lanes as a GCC/Clang vector type: plain code (inlined into functions
+// compiled for AVX2 + FMA, where each operation is one instruction).
 typedef double Vector4 __attribute__((vector_size(32)));
 
 struct Lanes4 {
@@ -119,22 +125,36 @@ struct Lanes4 {
   [[gnu::always_inline]] static void Store(double* p, Real v) {
     std::memcpy(p, &v, sizeof(v));
   }
-  [[gnu::always_inline]] static Real Broadcast(double x) {
+  [[gnu::always_inline]] static Real Broadcast(const double* p) {
+    const double x = *p;
     return Real{x, x, x, x};
   }
-  // Lane by lane; compiles to one vfmadd with FMA enabled.
+  [[gnu::always_inline]] static Real Add(Real a, Real b) { return a + b; }
+  [[gnu::always_inline]] static Real Sub(Real a, Real b) { return a - b; }
+  // Lane by lane; one vfmadd with FMA enabled.
   [[gnu::always_inline]] static Real Fma(Real a, Real b, Real c) {
     Real r;
     for (int i = 0; i < kWidth; ++i) r[i] = std::fma(a[i], b[i], c[i]);
     return r;
   }
-  [[gnu::always_inline]] static Real Add(Real a, Real b) { return a + b; }
-  [[gnu::always_inline]] static Real Sub(Real a, Real b) { return a - b; }
+  // a + b and a - b as a 1 + b and a 1 - b: the same rounding, on the FMA
+  // units (the additions alone would saturate the adder units).
+  [[gnu::always_inline]] static Real FmaAdd(Real a, Real b) {
+    return Fma(a, Real{1, 1, 1, 1}, b);
+  }
+  [[gnu::always_inline]] static Real FmaSub(Real a, Real b) {
+    return Fma(a, Real{1, 1, 1, 1}, -b);
+  }
 };
 
-// C(i, j) <- C(i, j) - sum_l A(i, l) B(j, l), l = 0 .. k-1 in order, for the
-// lower trapezoid 0 <= j < n, j <= i < m (m >= n): row i of A and of C and
-// row j of B are the same local index space, as for the rows of a supernode.
+// C(i, j) <- C(i, j) - sum_l A(i, l) B(j, l), l = 0 .. k-1 in order, for
+// 0 <= j < n and j <= i < m (m >= n): row i of A and of C and row j of B are
+// the same local index space, as for the rows of a supernode. Every entry
+// is computed by SubtractProducts over l = 0..K-1, K..2K-1, ...
+// (K = kMaxProducts; the blocks restart at l = 0 in every call). Entries
+// above the diagonal in the leading rows of each block of columns
+// (j0 <= i < j) are computed as well, from and into C's storage there, which
+// the callers never read.
 struct UpdateBlock {
   const double *a_hi, *a_lo;
   int lda;
@@ -145,68 +165,124 @@ struct UpdateBlock {
   int m, n, k;
 };
 
-template <class Lanes>
-[[gnu::always_inline]] inline void Step(double* c_hi, double* c_lo,
-                                        typename Lanes::Real x_hi,
-                                        typename Lanes::Real x_lo,
-                                        typename Lanes::Real y_hi,
-                                        typename Lanes::Real y_lo) {
-  typename Lanes::Real r_hi, r_lo;
-  MultiplySubtractParts<Lanes>(Lanes::Load(c_hi), Lanes::Load(c_lo), x_hi,
-                               x_lo, y_hi, y_lo, &r_hi, &r_lo);
-  Lanes::Store(c_hi, r_hi);
-  Lanes::Store(c_lo, r_lo);
-}
+constexpr int kInnerChunk = 32 * kMaxProducts;  // l per pass (cache reuse).
+constexpr int kRowChunk = 128;                  // Rows per pass.
+static_assert(kInnerChunk % kMaxProducts == 0, "blocks must not straddle");
 
-// Rows are processed in chunks that stay in the L1 cache across l.
-constexpr int kRowChunk = 128;
-constexpr int kColumnBlock = 4;
-
-// Columns j0 .. j0 + kColumns - 1 of the update.
-template <class Lanes, int kColumns>
-[[gnu::always_inline]] inline void UpdateColumns(const UpdateBlock& u,
-                                                 int j0) {
+// A kRows W x kColumns tile of C (at c, leading dimension ldc) minus `count`
+// products of A's rows (at a: A(i, l) = a[i + l lda]) and B's (b[j + l ldb]),
+// in blocks of kMaxProducts from the first: the accumulators stay in
+// registers.
+template <class Lanes, int kRows, int kColumns>
+[[gnu::always_inline]] inline void UpdateTile(const double* a_hi,
+                                              const double* a_lo, int lda,
+                                              const double* b_hi,
+                                              const double* b_lo, int ldb,
+                                              double* c_hi, double* c_lo,
+                                              int ldc, int count) {
   using Real = typename Lanes::Real;
   constexpr int W = Lanes::kWidth;
-  const int lda = u.lda, ldb = u.ldb, ldc = u.ldc;
-  // The triangle i < j0 + kColumns (scalar).
-  const int corner = std::min(u.m, j0 + kColumns);
-  for (int l = 0; l < u.k; ++l) {
-    for (int jj = 0; jj < kColumns; ++jj) {
-      const int j = j0 + jj;
-      const double y_hi = u.b_hi[j + l * ldb], y_lo = u.b_lo[j + l * ldb];
-      for (int i = j; i < corner; ++i) {
-        Step<ScalarLanes>(u.c_hi + i + j * ldc, u.c_lo + i + j * ldc,
-                          u.a_hi[i + l * lda], u.a_lo[i + l * lda], y_hi, y_lo);
+  Real T[kRows][kColumns], t[kRows][kColumns];
+#pragma GCC unroll 4
+  for (int c = 0; c < kColumns; ++c) {
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) {
+      T[r][c] = Lanes::Load(c_hi + r * W + c * ldc);
+      t[r][c] = Lanes::Load(c_lo + r * W + c * ldc);
+    }
+  }
+  for (int lb = 0; lb < count; lb += kMaxProducts) {
+    const int le = std::min(count, lb + kMaxProducts);
+    for (int l = lb; l < le; ++l) {
+      Real x_hi[kRows], x_lo[kRows];
+#pragma GCC unroll 4
+      for (int r = 0; r < kRows; ++r) {
+        x_hi[r] = Lanes::Load(a_hi + l * lda + r * W);
+        x_lo[r] = Lanes::Load(a_lo + l * lda + r * W);
+      }
+#pragma GCC unroll 4
+      for (int c = 0; c < kColumns; ++c) {
+        const Real y_hi = Lanes::Broadcast(b_hi + l * ldb + c);
+        const Real y_lo = Lanes::Broadcast(b_lo + l * ldb + c);
+#pragma GCC unroll 4
+        for (int r = 0; r < kRows; ++r) {
+          SubtractProductParts<Lanes>(x_hi[r], x_lo[r], y_hi, y_lo, &T[r][c],
+                                      &t[r][c]);
+        }
+      }
+    }
+#pragma GCC unroll 4
+    for (int c = 0; c < kColumns; ++c) {
+#pragma GCC unroll 4
+      for (int r = 0; r < kRows; ++r) {
+        RenormalizeParts<Lanes>(&T[r][c], &t[r][c]);
       }
     }
   }
-  for (int i0 = corner; i0 < u.m; i0 += kRowChunk) {
-    const int i1 = std::min(u.m, i0 + kRowChunk);
-    for (int l = 0; l < u.k; ++l) {
-      Real y_hi[kColumns], y_lo[kColumns];
-      for (int jj = 0; jj < kColumns; ++jj) {
-        y_hi[jj] = Lanes::Broadcast(u.b_hi[j0 + jj + l * ldb]);
-        y_lo[jj] = Lanes::Broadcast(u.b_lo[j0 + jj + l * ldb]);
+#pragma GCC unroll 4
+  for (int c = 0; c < kColumns; ++c) {
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) {
+      Lanes::Store(c_hi + r * W + c * ldc, T[r][c]);
+      Lanes::Store(c_lo + r * W + c * ldc, t[r][c]);
+    }
+  }
+}
+
+// Columns j0 .. j0 + kColumns - 1, rows [max(j0, i0), i1), l in [l0, l1):
+// tiles of kRows vectors (several independent accumulators per column hide
+// the latency of each one's chain), then single vectors; the last rows
+// (fewer than W) are copied into zero-padded buffers for one more vector
+// tile (lanes are independent: the same operations as on their own).
+template <class Lanes, int kColumns>
+[[gnu::always_inline]] inline void UpdateColumns(const UpdateBlock& u, int j0,
+                                                 int i0, int i1, int l0,
+                                                 int l1) {
+  constexpr int W = Lanes::kWidth;
+  constexpr int kRows = kColumns >= 3 ? 1 : (kColumns == 2 ? 2 : 3);
+  const int count = l1 - l0;
+  const long long a0 = static_cast<long long>(l0) * u.lda;
+  const double* b_hi = u.b_hi + static_cast<long long>(l0) * u.ldb + j0;
+  const double* b_lo = u.b_lo + static_cast<long long>(l0) * u.ldb + j0;
+  const long long c0 = static_cast<long long>(j0) * u.ldc;
+  int i = std::max(i0, j0);
+  for (; i + kRows * W <= i1; i += kRows * W) {
+    UpdateTile<Lanes, kRows, kColumns>(u.a_hi + a0 + i, u.a_lo + a0 + i, u.lda,
+                                       b_hi, b_lo, u.ldb, u.c_hi + c0 + i,
+                                       u.c_lo + c0 + i, u.ldc, count);
+  }
+  for (; i + W <= i1; i += W) {
+    UpdateTile<Lanes, 1, kColumns>(u.a_hi + a0 + i, u.a_lo + a0 + i, u.lda,
+                                   b_hi, b_lo, u.ldb, u.c_hi + c0 + i,
+                                   u.c_lo + c0 + i, u.ldc, count);
+  }
+  const int rest = i1 - i;
+  if (rest > 0) {
+    double pa_hi[kInnerChunk * W], pa_lo[kInnerChunk * W];
+    double pc_hi[kColumns * W], pc_lo[kColumns * W];
+    for (int l = 0; l < count; ++l) {
+      for (int r = 0; r < W; ++r) {
+        const bool in = r < rest;
+        const long long q = a0 + static_cast<long long>(l) * u.lda + i + r;
+        pa_hi[l * W + r] = in ? u.a_hi[q] : 0;
+        pa_lo[l * W + r] = in ? u.a_lo[q] : 0;
       }
-      const double* a_hi = u.a_hi + l * lda;
-      const double* a_lo = u.a_lo + l * lda;
-      double* c_hi = u.c_hi + j0 * ldc;
-      double* c_lo = u.c_lo + j0 * ldc;
-      int i = i0;
-      for (; i + W <= i1; i += W) {
-        const Real x_hi = Lanes::Load(a_hi + i), x_lo = Lanes::Load(a_lo + i);
-        for (int jj = 0; jj < kColumns; ++jj) {
-          Step<Lanes>(c_hi + i + jj * ldc, c_lo + i + jj * ldc, x_hi, x_lo,
-                      y_hi[jj], y_lo[jj]);
-        }
+    }
+    for (int c = 0; c < kColumns; ++c) {
+      for (int r = 0; r < W; ++r) {
+        const bool in = r < rest;
+        const long long q = c0 + static_cast<long long>(c) * u.ldc + i + r;
+        pc_hi[c * W + r] = in ? u.c_hi[q] : 0;
+        pc_lo[c * W + r] = in ? u.c_lo[q] : 0;
       }
-      for (; i < i1; ++i) {
-        for (int jj = 0; jj < kColumns; ++jj) {
-          Step<ScalarLanes>(c_hi + i + jj * ldc, c_lo + i + jj * ldc, a_hi[i],
-                            a_lo[i], u.b_hi[j0 + jj + l * ldb],
-                            u.b_lo[j0 + jj + l * ldb]);
-        }
+    }
+    UpdateTile<Lanes, 1, kColumns>(pa_hi, pa_lo, W, b_hi, b_lo, u.ldb, pc_hi,
+                                   pc_lo, W, count);
+    for (int c = 0; c < kColumns; ++c) {
+      for (int r = 0; r < rest; ++r) {
+        const long long q = c0 + static_cast<long long>(c) * u.ldc + i + r;
+        u.c_hi[q] = pc_hi[c * W + r];
+        u.c_lo[q] = pc_lo[c * W + r];
       }
     }
   }
@@ -214,19 +290,26 @@ template <class Lanes, int kColumns>
 
 template <class Lanes>
 [[gnu::always_inline]] inline void Update(const UpdateBlock& u) {
-  for (int j0 = 0; j0 < u.n; j0 += kColumnBlock) {
-    switch (std::min(kColumnBlock, u.n - j0)) {
-      case 4:
-        UpdateColumns<Lanes, 4>(u, j0);
-        break;
-      case 3:
-        UpdateColumns<Lanes, 3>(u, j0);
-        break;
-      case 2:
-        UpdateColumns<Lanes, 2>(u, j0);
-        break;
-      default:
-        UpdateColumns<Lanes, 1>(u, j0);
+  constexpr int kColumnBlock = 4;
+  for (int l0 = 0; l0 < u.k; l0 += kInnerChunk) {
+    const int l1 = std::min(u.k, l0 + kInnerChunk);
+    for (int i0 = 0; i0 < u.m; i0 += kRowChunk) {
+      const int i1 = std::min(u.m, i0 + kRowChunk);
+      for (int j0 = 0; j0 < std::min(u.n, i1); j0 += kColumnBlock) {
+        switch (std::min(kColumnBlock, u.n - j0)) {
+          case 4:
+            UpdateColumns<Lanes, 4>(u, j0, i0, i1, l0, l1);
+            break;
+          case 3:
+            UpdateColumns<Lanes, 3>(u, j0, i0, i1, l0, l1);
+            break;
+          case 2:
+            UpdateColumns<Lanes, 2>(u, j0, i0, i1, l0, l1);
+            break;
+          default:
+            UpdateColumns<Lanes, 1>(u, j0, i0, i1, l0, l1);
+        }
+      }
     }
   }
 }
@@ -380,7 +463,8 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
     const int first = super_start_[s];
     const int ncols = super_start_[s + 1] - first;
     for (int j = first; j < first + ncols; ++j) column_super_[j] = s;
-    super_row_.insert(super_row_.end(), factor_row_.begin() + factor_start_[first],
+    super_row_.insert(super_row_.end(),
+                      factor_row_.begin() + factor_start_[first],
                       factor_row_.begin() + factor_start_[first + 1]);
     super_row_start_.push_back(static_cast<int>(super_row_.size()));
     const long long nrows = count(first);
@@ -480,6 +564,11 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
         }
         for (int j = 0; j < n; ++j) {
           const long long column = static_cast<long long>(relative[j]) * nrows;
+          // Zeros above the diagonal where the kernel computes unused
+          // entries (from the start of j's block of 4 columns).
+          for (int i = j & ~3; i < j; ++i) {
+            work_hi[i + j * m] = work_lo[i + j * m] = 0;
+          }
           for (int i = j; i < m; ++i) {
             work_hi[i + j * m] = s_hi[column + relative[i]];
             work_lo[i + j * m] = s_lo[column + relative[i]];
@@ -518,8 +607,8 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     const double* s_hi = super_hi_.data() + super_value_start_[s];
     const double* s_lo = super_lo_.data() + super_value_start_[s];
     for (int j = first; j < super_start_[s + 1]; ++j) {
-      const long long offset = static_cast<long long>(j - first) * nrows +
-                               (j - first);
+      const long long offset =
+          static_cast<long long>(j - first) * nrows + (j - first);
       for (int p = factor_start_[j]; p < factor_start_[j + 1]; ++p) {
         const long long t = offset + (p - factor_start_[j]);
         factor_value_[p] = DoubleDouble(s_hi[t], s_lo[t]);
