@@ -92,6 +92,8 @@ class DoubleDoubleCholesky {
   // After Analyze(), supernodal: the supernodes and their stored entries
   // (dense blocks, including the explicit zeros of merged supernodes and
   // the unused upper triangles of the diagonal blocks).
+  // Supernode s holds columns supernode_start()[s] .. [s + 1] - 1.
+  const std::vector<int>& supernode_start() const { return super_start_; }
   int num_supernodes() const {
     return super_start_.empty() ? 0 : static_cast<int>(super_start_.size()) - 1;
   }
