@@ -238,6 +238,27 @@ void Run(const std::string& path) {
       supernodal.supernodal_entries() /
           static_cast<double>(supernodal.factor_nonzeros()),
       supernodal.vectorized() ? "yes" : "no");
+  {
+    // The work (multiply-adds) by supernode width.
+    const int edges[] = {1, 2, 4, 8, 16, 32, 64, 1 << 30};
+    double work[8] = {0};
+    const std::vector<int>& super = supernodal.supernode_start();
+    for (int s = 0; s < supernodal.num_supernodes(); ++s) {
+      const int width = super[s + 1] - super[s];
+      int b = 0;
+      while (width >= edges[b + 1]) ++b;
+      for (int j = super[s]; j < super[s + 1]; ++j) {
+        const double count =
+            supernodal.factor_start()[j + 1] - supernodal.factor_start()[j];
+        work[b] += 0.5 * count * count;
+      }
+    }
+    std::printf("  work by supernode width:");
+    for (int b = 0; b < 7; ++b) {
+      std::printf(" %d+: %.0f%%", edges[b], 100 * work[b] / flops);
+    }
+    std::printf("\n");
+  }
   auto report = [&](const char* name, const Timing& t) {
     std::printf(
         "  %-22s analyze %8.3f s  factorize %8.3f s  (%.2f ns per "

@@ -232,13 +232,28 @@ inline DoubleDouble SubtractProducts(const DoubleDouble& s,
   return {T, t};
 }
 
-// Joldes-Muller-Popescu Algorithm 12 (DWTimesDW3).
+// Joldes-Muller-Popescu Algorithm 12 (DWTimesDW3), on parts as above (the
+// kernels scale columns with it).
+template <class Ops, class Real>
+[[gnu::always_inline]] inline void MultiplyParts(Real x_hi, Real x_lo,
+                                                 Real y_hi, Real y_lo,
+                                                 Real* r_hi, Real* r_lo) {
+  const Real p = x_hi * y_hi;
+  const Real e = Ops::Fma(x_hi, y_hi, -p);  // TwoProduct.
+  const Real tl0 = x_lo * y_lo;
+  const Real tl1 = Ops::Fma(x_hi, y_lo, tl0);
+  const Real cl2 = Ops::Fma(x_lo, y_hi, tl1);
+  const Real b = Ops::Add(e, cl2);
+  // FastTwoSum(p, b).
+  const Real s = Ops::Add(p, b);
+  *r_lo = Ops::Sub(b, Ops::Sub(s, p));
+  *r_hi = s;
+}
+
 inline DoubleDouble operator*(const DoubleDouble& x, const DoubleDouble& y) {
-  const DoubleDouble c = dd::TwoProduct(x.hi, y.hi);
-  const double tl0 = x.lo * y.lo;
-  const double tl1 = std::fma(x.hi, y.lo, tl0);
-  const double cl2 = std::fma(x.lo, y.hi, tl1);
-  return dd::FastTwoSum(c.hi, c.lo + cl2);
+  DoubleDouble r;
+  MultiplyParts<DoubleOps>(x.hi, x.lo, y.hi, y.lo, &r.hi, &r.lo);
+  return r;
 }
 
 // 1 / x by one Newton step from the correctly rounded double reciprocal

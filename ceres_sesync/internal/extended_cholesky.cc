@@ -239,7 +239,7 @@ template <class Lanes, int kColumns>
                                                  int i0, int i1, int l0,
                                                  int l1) {
   constexpr int W = Lanes::kWidth;
-  constexpr int kRows = kColumns >= 3 ? 1 : (kColumns == 2 ? 2 : 3);
+  constexpr int kRows = kColumns >= 3 ? 2 : 4;
   const int count = l1 - l0;
   const long long a0 = static_cast<long long>(l0) * u.lda;
   const double* b_hi = u.b_hi + static_cast<long long>(l0) * u.ldb + j0;
@@ -314,21 +314,58 @@ template <class Lanes>
   }
 }
 
+// x(i) <- x(i) * y for i < m (DoubleDouble's operator*, lane by lane).
+template <class Lanes>
+[[gnu::always_inline]] inline void Scale(int m, double* x_hi, double* x_lo,
+                                         double y_hi, double y_lo) {
+  using Real = typename Lanes::Real;
+  constexpr int W = Lanes::kWidth;
+  const Real yh = Lanes::Broadcast(&y_hi), yl = Lanes::Broadcast(&y_lo);
+  int i = 0;
+  for (; i + W <= m; i += W) {
+    Real r_hi, r_lo;
+    MultiplyParts<Lanes>(Lanes::Load(x_hi + i), Lanes::Load(x_lo + i), yh, yl,
+                         &r_hi, &r_lo);
+    Lanes::Store(x_hi + i, r_hi);
+    Lanes::Store(x_lo + i, r_lo);
+  }
+  for (; i < m; ++i) {
+    MultiplyParts<ScalarLanes>(x_hi[i], x_lo[i], y_hi, y_lo, x_hi + i,
+                               x_lo + i);
+  }
+}
+
 void UpdatePortable(const UpdateBlock& u) { Update<ScalarLanes>(u); }
+void ScalePortable(int m, double* x_hi, double* x_lo, double y_hi,
+                   double y_lo) {
+  Scale<ScalarLanes>(m, x_hi, x_lo, y_hi, y_lo);
+}
 
 #if defined(__x86_64__) || defined(__i386__)
 __attribute__((target("avx2,fma"))) void UpdateAvx2(const UpdateBlock& u) {
   Update<Lanes4>(u);
+}
+__attribute__((target("avx2,fma"))) void ScaleAvx2(int m, double* x_hi,
+                                                   double* x_lo, double y_hi,
+                                                   double y_lo) {
+  Scale<Lanes4>(m, x_hi, x_lo, y_hi, y_lo);
 }
 bool HaveAvx2() {
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }
 #else
 void UpdateAvx2(const UpdateBlock& u) { UpdatePortable(u); }
+void ScaleAvx2(int m, double* x_hi, double* x_lo, double y_hi, double y_lo) {
+  ScalePortable(m, x_hi, x_lo, y_hi, y_lo);
+}
 bool HaveAvx2() { return false; }
 #endif
 
-using UpdateFunction = void (*)(const UpdateBlock&);
+// The kernels of one instruction set.
+struct Kernels {
+  void (*update)(const UpdateBlock&);
+  void (*scale)(int m, double* x_hi, double* x_lo, double y_hi, double y_lo);
+};
 
 // Factors one supernode in place after all updates from below: its nrows x
 // ncols block X (column-major, leading dimension nrows, hi/lo parts), with
@@ -339,22 +376,23 @@ using UpdateFunction = void (*)(const UpdateBlock&);
 // that is not positive or not safe.
 constexpr int kPanel = 32;
 
-bool FactorSupernode(UpdateFunction update, int nrows, int ncols, double* hi,
+bool FactorSupernode(const Kernels& kernels, int nrows, int ncols, double* hi,
                      double* lo) {
   const int ld = nrows;
   for (int c0 = 0; c0 < ncols; c0 += kPanel) {
     const int c1 = std::min(ncols, c0 + kPanel);
     if (c0 > 0) {
-      update({hi + c0, lo + c0, ld, hi + c0, lo + c0, ld, hi + c0 + c0 * ld,
-              lo + c0 + c0 * ld, ld, nrows - c0, c1 - c0, c0});
+      kernels.update({hi + c0, lo + c0, ld, hi + c0, lo + c0, ld,
+                      hi + c0 + c0 * ld, lo + c0 + c0 * ld, ld, nrows - c0,
+                      c1 - c0, c0});
     }
     for (int j = c0; j < c1; ++j) {
       double* x_hi = hi + j * ld;
       double* x_lo = lo + j * ld;
       if (j > c0) {
-        update({hi + j + c0 * ld, lo + j + c0 * ld, ld, hi + j + c0 * ld,
-                lo + j + c0 * ld, ld, x_hi + j, x_lo + j, ld, nrows - j, 1,
-                j - c0});
+        kernels.update({hi + j + c0 * ld, lo + j + c0 * ld, ld,
+                        hi + j + c0 * ld, lo + j + c0 * ld, ld, x_hi + j,
+                        x_lo + j, ld, nrows - j, 1, j - c0});
       }
       const DoubleDouble d(x_hi[j], x_lo[j]);
       if (!(d.hi > 0) || !Safe(d)) return false;
@@ -362,11 +400,8 @@ bool FactorSupernode(UpdateFunction update, int nrows, int ncols, double* hi,
       const DoubleDouble inverse = Reciprocal(l_jj);
       x_hi[j] = l_jj.hi;
       x_lo[j] = l_jj.lo;
-      for (int i = j + 1; i < nrows; ++i) {
-        const DoubleDouble l_ij = DoubleDouble(x_hi[i], x_lo[i]) * inverse;
-        x_hi[i] = l_ij.hi;
-        x_lo[i] = l_ij.lo;
-      }
+      kernels.scale(nrows - j - 1, x_hi + j + 1, x_lo + j + 1, inverse.hi,
+                    inverse.lo);
     }
   }
   return true;
@@ -510,7 +545,8 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
 bool DoubleDoubleCholesky::FactorizeSupernodal(
     const std::vector<DoubleDouble>& values) {
   const int num_super = num_supernodes();
-  const UpdateFunction update = vectorized_ ? UpdateAvx2 : UpdatePortable;
+  const Kernels kernels = vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2}
+                                      : Kernels{UpdatePortable, ScalePortable};
   super_hi_.assign(supernodal_entries(), 0.0);
   super_lo_.assign(supernodal_entries(), 0.0);
   for (size_t p = 0; p < values.size(); ++p) {
@@ -550,10 +586,10 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       // target entries, update, scatter.
       const int r0 = position[d_rows[p1]];
       if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
-        update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
-                s_hi + r0 + static_cast<long long>(r0) * nrows,
-                s_lo + r0 + static_cast<long long>(r0) * nrows, nrows, m, n,
-                k});
+        kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                        s_hi + r0 + static_cast<long long>(r0) * nrows,
+                        s_lo + r0 + static_cast<long long>(r0) * nrows, nrows,
+                        m, n, k});
       } else {
         relative.resize(m);
         for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
@@ -574,8 +610,8 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
             work_lo[i + j * m] = s_lo[column + relative[i]];
           }
         }
-        update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows, work_hi.data(),
-                work_lo.data(), m, m, n, k});
+        kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                        work_hi.data(), work_lo.data(), m, m, n, k});
         for (int j = 0; j < n; ++j) {
           const long long column = static_cast<long long>(relative[j]) * nrows;
           for (int i = j; i < m; ++i) {
@@ -592,7 +628,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       }
       d = d_next;
     }
-    if (!FactorSupernode(update, nrows, ncols, s_hi, s_lo)) return false;
+    if (!FactorSupernode(kernels, nrows, ncols, s_hi, s_lo)) return false;
     pointer[s] = ncols;
     if (ncols < nrows) {
       const int target = column_super_[rows[ncols]];
