@@ -95,10 +95,11 @@ __attribute__((target_clones("fma", "default"))) bool FactorizeRows(
 //
 // Double-double matrices are stored as two column-major arrays of doubles
 // (high and low parts) with a common leading dimension, so that W
-// consecutive rows load as one W-lane vector. Every kernel applies
-// MultiplySubtract to each entry over the inner index in increasing order;
-// the lanes of a vector are independent entries, so the vectorized and the
-// portable instantiations compute bitwise the same results.
+// consecutive rows load as one W-lane vector. The update kernel applies
+// SubtractProducts to each entry over the inner index in increasing order,
+// in blocks of kMaxProducts that depend only on the call; the lanes of a
+// vector are independent entries, so the vectorized and the portable
+// instantiations compute bitwise the same results.
 
 // Lanes: the portable scalar, and 4 doubles (AVX2), with the operations
 // SubtractProductParts takes.
@@ -167,6 +168,7 @@ struct UpdateBlock {
 
 constexpr int kInnerChunk = 32 * kMaxProducts;  // l per pass (cache reuse).
 constexpr int kRowChunk = 128;                  // Rows per pass.
+constexpr int kColumnBlock = 4;                 // Columns per tile (at most).
 static_assert(kInnerChunk % kMaxProducts == 0, "blocks must not straddle");
 
 // A kRows W x kColumns tile of C (at c, leading dimension ldc) minus `count`
@@ -290,7 +292,6 @@ template <class Lanes, int kColumns>
 
 template <class Lanes>
 [[gnu::always_inline]] inline void Update(const UpdateBlock& u) {
-  constexpr int kColumnBlock = 4;
   for (int l0 = 0; l0 < u.k; l0 += kInnerChunk) {
     const int l1 = std::min(u.k, l0 + kInnerChunk);
     for (int i0 = 0; i0 < u.m; i0 += kRowChunk) {
@@ -379,20 +380,24 @@ constexpr int kPanel = 32;
 bool FactorSupernode(const Kernels& kernels, int nrows, int ncols, double* hi,
                      double* lo) {
   const int ld = nrows;
+  // Entry (i, j) of the block.
+  auto at = [ld](double* x, int i, int j) {
+    return x + i + static_cast<long long>(j) * ld;
+  };
   for (int c0 = 0; c0 < ncols; c0 += kPanel) {
     const int c1 = std::min(ncols, c0 + kPanel);
     if (c0 > 0) {
       kernels.update({hi + c0, lo + c0, ld, hi + c0, lo + c0, ld,
-                      hi + c0 + c0 * ld, lo + c0 + c0 * ld, ld, nrows - c0,
-                      c1 - c0, c0});
+                      at(hi, c0, c0), at(lo, c0, c0), ld, nrows - c0, c1 - c0,
+                      c0});
     }
     for (int j = c0; j < c1; ++j) {
-      double* x_hi = hi + j * ld;
-      double* x_lo = lo + j * ld;
+      double* x_hi = at(hi, 0, j);
+      double* x_lo = at(lo, 0, j);
       if (j > c0) {
-        kernels.update({hi + j + c0 * ld, lo + j + c0 * ld, ld,
-                        hi + j + c0 * ld, lo + j + c0 * ld, ld, x_hi + j,
-                        x_lo + j, ld, nrows - j, 1, j - c0});
+        kernels.update({at(hi, j, c0), at(lo, j, c0), ld, at(hi, j, c0),
+                        at(lo, j, c0), ld, x_hi + j, x_lo + j, ld, nrows - j, 1,
+                        j - c0});
       }
       const DoubleDouble d(x_hi[j], x_lo[j]);
       if (!(d.hi > 0) || !Safe(d)) return false;
@@ -599,24 +604,30 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
           work_lo.resize(size);
         }
         for (int j = 0; j < n; ++j) {
-          const long long column = static_cast<long long>(relative[j]) * nrows;
+          const double* t_hi =
+              s_hi + static_cast<long long>(relative[j]) * nrows;
+          const double* t_lo =
+              s_lo + static_cast<long long>(relative[j]) * nrows;
+          double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+          double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
           // Zeros above the diagonal where the kernel computes unused
-          // entries (from the start of j's block of 4 columns).
-          for (int i = j & ~3; i < j; ++i) {
-            work_hi[i + j * m] = work_lo[i + j * m] = 0;
-          }
+          // entries (from the start of j's block of columns).
+          for (int i = j - j % kColumnBlock; i < j; ++i) w_hi[i] = w_lo[i] = 0;
           for (int i = j; i < m; ++i) {
-            work_hi[i + j * m] = s_hi[column + relative[i]];
-            work_lo[i + j * m] = s_lo[column + relative[i]];
+            w_hi[i] = t_hi[relative[i]];
+            w_lo[i] = t_lo[relative[i]];
           }
         }
         kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
                         work_hi.data(), work_lo.data(), m, m, n, k});
         for (int j = 0; j < n; ++j) {
-          const long long column = static_cast<long long>(relative[j]) * nrows;
+          double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
+          double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
+          const double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+          const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
           for (int i = j; i < m; ++i) {
-            s_hi[column + relative[i]] = work_hi[i + j * m];
-            s_lo[column + relative[i]] = work_lo[i + j * m];
+            t_hi[relative[i]] = w_hi[i];
+            t_lo[relative[i]] = w_lo[i];
           }
         }
       }

@@ -22,14 +22,15 @@
 //    consecutive columns with the same pattern below their diagonal block,
 //    stored as dense column-major blocks (Ng and Peyton, SIAM J. Sci. Comput.
 //    14(5), 1993; Davis, "Direct Methods for Sparse Linear Systems", SIAM
-//    2006, Ch. 9). Each supernode receives the updates of the supernodes
-//    below it, C -= A B^T, then factors its diagonal block and solves its
-//    off-diagonal block column by column; every inner-product step is one
-//    MultiplySubtract (double_double.h), vectorized over rows with AVX2+FMA
-//    when the CPU has them (bitwise the same results as the portable code:
-//    each entry sees the same operations in the same order, lanes are
-//    independent, and std::fma is correctly rounded everywhere).
-//  - simplicial: the up-looking (row by row) scheme (Davis Sec. 4.2), kept as
+//    2006, Ch. 4). Each supernode receives the updates of the supernodes
+//    below it, C -= A B^T, then factors its diagonal block and scales its
+//    off-diagonal block, in panels of columns. The inner products run in
+//    SubtractProducts steps (double_double.h: one renormalization per 8
+//    products, within the same Cray-style model), vectorized over rows with
+//    AVX2+FMA when the CPU has them: bitwise the same results as the
+//    portable code, since each entry sees the same operations in the same
+//    order and the lanes are independent entries.
+//  - simplicial: the up-looking (row by row) scheme (Davis Ch. 4), kept as
 //    the reference.
 // Results do not depend on the machine (std::fma is correctly rounded in
 // hardware or in software; the file is compiled with -ffp-contract=off).
