@@ -132,12 +132,11 @@ TEST(DoubleDouble, AccumulateSubtractMeetsItsCrayBound) {
 
 // SubtractProducts(s, x, y, K), K = 1..kMaxProducts, within its bound
 // |r - (s - sum_j x_j y_j)| <= (K^2 + 2K) u^2 |s| + sum_j (n_j^2 + 6 n_j + 6)
-// u^2 |x_j y_j| (n_j = K - j + 1; the factors (1 + 40u) are below the
-// binary128 reference's own rounding, ~(K + 1) 2^-113 of the terms, which
-// the bound's constants dwarf), and within the single-step Cray bound
-// 3.01 u^2 |s| + 13.01 u^2 |x y| for K = 1. Includes near-cancellation of s
-// against the products. The result is normalized, and zero products are
-// exact no-ops.
+// u^2 |x_j y_j| (n_j = K - j + 1), tested without the factors (1 + 40u),
+// and within the single-step Cray bound 3.01 u^2 |s| + 13.01 u^2 |x y| for
+// K = 1. The binary128 reference errs by ~(K + 1) 2^-113 (~0.07 u^2) of the
+// terms, far below the bounds. Includes near-cancellation of s against the
+// products. The result is normalized, and zero products are exact no-ops.
 TEST(DoubleDouble, SubtractProductsMeetsItsBound) {
   std::mt19937_64 rng(4);
   std::uniform_int_distribution<int> count(1, kMaxProducts);
