@@ -552,13 +552,14 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   const int num_super = num_supernodes();
   const Kernels kernels = vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2}
                                       : Kernels{UpdatePortable, ScalePortable};
-  super_hi_.assign(supernodal_entries(), 0.0);
-  super_lo_.assign(supernodal_entries(), 0.0);
+  // The dense blocks (only for the factorization: L is copied out).
+  std::vector<double> super_hi(supernodal_entries(), 0.0);
+  std::vector<double> super_lo(supernodal_entries(), 0.0);
   for (size_t p = 0; p < values.size(); ++p) {
     // Renormalized (the same value): the kernels' bounds assume it.
     const DoubleDouble v = dd::TwoSum(values[p].hi, values[p].lo);
-    super_hi_[value_destination_[p]] = v.hi;
-    super_lo_[value_destination_[p]] = v.lo;
+    super_hi[value_destination_[p]] = v.hi;
+    super_lo[value_destination_[p]] = v.lo;
   }
   // Left-looking: supernode d, once factored, waits in the list of the
   // supernode holding its next row below the ones already applied
@@ -572,8 +573,8 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     const int ncols = last - first;
     const int nrows = super_row_start_[s + 1] - super_row_start_[s];
     const int* rows = super_row_.data() + super_row_start_[s];
-    double* s_hi = super_hi_.data() + super_value_start_[s];
-    double* s_lo = super_lo_.data() + super_value_start_[s];
+    double* s_hi = super_hi.data() + super_value_start_[s];
+    double* s_lo = super_lo.data() + super_value_start_[s];
     for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
     for (int d = head[s]; d != -1;) {
       const int d_next = next[d];
@@ -583,8 +584,8 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       int p2 = p1;
       while (p2 < d_nrows && d_rows[p2] < last) ++p2;
       const int m = d_nrows - p1, n = p2 - p1;
-      const double* d_hi = super_hi_.data() + super_value_start_[d] + p1;
-      const double* d_lo = super_lo_.data() + super_value_start_[d] + p1;
+      const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
+      const double* d_lo = super_lo.data() + super_value_start_[d] + p1;
       const int k = super_start_[d + 1] - super_start_[d];
       // The target rows of d's rows p1.. are contiguous in s (positions
       // increase with the rows): update s in place; otherwise gather the
@@ -651,8 +652,8 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   for (int s = 0; s < num_super; ++s) {
     const int first = super_start_[s];
     const int nrows = super_row_start_[s + 1] - super_row_start_[s];
-    const double* s_hi = super_hi_.data() + super_value_start_[s];
-    const double* s_lo = super_lo_.data() + super_value_start_[s];
+    const double* s_hi = super_hi.data() + super_value_start_[s];
+    const double* s_lo = super_lo.data() + super_value_start_[s];
     for (int j = first; j < super_start_[s + 1]; ++j) {
       const long long offset =
           static_cast<long long>(j - first) * nrows + (j - first);

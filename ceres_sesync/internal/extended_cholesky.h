@@ -122,12 +122,11 @@ class DoubleDoubleCholesky {
   // Supernodes: columns super_start_[s] .. super_start_[s+1] - 1, rows
   // super_row_[super_row_start_[s] ..] (increasing, its columns first), values
   // (column-major, leading dimension = its row count) at
-  // super_value_start_[s] in super_hi_ / super_lo_.
+  // super_value_start_[s] in the dense blocks of FactorizeSupernodal().
   std::vector<int> super_start_, super_row_start_, super_row_;
   std::vector<long long> super_value_start_;
   std::vector<int> column_super_;             // Supernode of each column.
   std::vector<long long> value_destination_;  // Input value -> block entry.
-  std::vector<double> super_hi_, super_lo_;
 };
 
 }  // namespace ceres_sesync::internal
