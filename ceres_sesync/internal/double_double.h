@@ -43,6 +43,57 @@
 // in the proof of Higham's Lemma 8.4 (Higham's Ch. 2 notes the same of the
 // model for arithmetic without a guard digit), so the Cholesky bound
 // gamma_{k+1} |L||L^T| holds with kDoubleDoubleUnitRoundoff.
+//
+// SubtractProducts(s, x, y, K) (the inner loop of the supernodal
+// factorization) computes s - sum_{j=1..K} x_j y_j for K <= kMaxProducts
+// with ONE renormalization: the high parts T_j accumulate exactly by TwoSum,
+// the low parts t_j (errors and low products) in double, and TwoSum(T_K,
+// t_K) at the end. It satisfies the Cray-style model with the products
+// fused:
+//
+//   fl(s - sum_j x_j y_j) = s (1 + alpha) - sum_j x_j y_j (1 + beta_j),
+//   |alpha| <= (K^2 + 2K) u^2 (1 + 40u),
+//   |beta_j| <= (n_j^2 + 6 n_j + 6) u^2 (1 + 40u),  n_j = K - j + 1
+//
+// (n_j: the steps from product j to the end; K = 1: 3.01 u^2 and 13.01 u^2).
+// Since K^2 + 2K <= 32 K and n^2 + 6n + 6 <= 32 n for 1 <= n <= 25, this is
+// at most what K steps of the Cray model with kDoubleDoubleUnitRoundoff give
+// the accumulator (K factors) and product j (n_j factors), so in the
+// recursion of Lemma 8.4 (with Higham's Lemma 3.3, (1 + theta_a)(1 +
+// theta_b) = 1 + theta_{a+b}) every term of an entry still carries at most
+// theta_m for m the products from it to the end: the Cholesky bound
+// gamma_{k+1} |L||L^T| holds unchanged, whatever the blocking.
+//
+// Derivation (normalized operands, |z_lo| <= u |z_hi|, P_j = |x_j,hi
+// y_j,hi|, m_j = |s_hi| + sum_{i<=j} P_i). Step j: p_j = RN(x_hi y_hi);
+// p_e = x_hi y_hi - p_j exactly by an FMA, |p_e| <= u P_j; a = RN(x_hi y_lo +
+// p_e) (FMA, error <= 2u^2 P_j, |a| <= 2u (1 + u) P_j); q_j = RN(x_lo y_hi +
+// a) (FMA, error <= (3u^2 + 2u^3) P_j, |q_j| <= (3u + 6u^2) P_j), so q_j is
+// within (5u^2 + 2u^3) P_j of Q_j = p_e + x_hi y_lo + x_lo y_hi, and x_lo y_lo
+// (<= u^2 P_j) is dropped. (T_j, e_j) = TwoSum(T_{j-1}, -p_j) is exact with
+// |e_j| <= u |T_j| <= u (1 + 10u) m_j (T_0 = s_hi; |T_j| <= (1 + u)^{j+1}
+// m_j). w_j = RN(t_{j-1} - q_j) and t_j = RN(e_j + w_j) (t_0 = s_lo) err by
+// at most u (2 + u)(|t_{j-1}| + |q_j|) + u |e_j| together. Unrolling,
+// r = T_K + t_K = s - sum_j (p_j + q_j) + sum_j (roundings of w_j, t_j), so
+//   |r - (s - sum_j x_j y_j)| <= sum_j (6u^2 + 2u^3) P_j
+//                                + sum_j (roundings of w_j and t_j),
+// and |t_{j-1}| <= (1 + 28u) tau_{j-1} with tau_{j-1} = u (|s_hi| +
+// sum_{i<j} (3 P_i + m_i)) = u (j |s_hi| + sum_{i<j} (3 + j - i) P_i). Step
+// j's roundings are therefore at most u^2 (1 + 32u) ((2j + 1) |s_hi| +
+// sum_{i<=j} (7 + 2 (j - i)) P_i); summed over j = 1..K, |s_hi| collects
+// K^2 + 2K and P_i collects sum_{j=i..K} (7 + 2 (j - i)) = n_i^2 + 6 n_i.
+// With |s_hi| <= |s| / (1 - u) and P_j <= |x_j y_j| / (1 - u)^2 the bounds
+// above follow (the (1 + 40u) covers every second-order factor for
+// K <= 8). A zero product (x or y zero) is an exact no-op on (T, t) (p =
+// p_e = a = q = 0, e = 0), so explicit zeros change no result.
+//
+// Underflow (operands or products below 2^-969, where the low parts lose
+// bits): every rounding above obeys fl(z) = z (1 + delta) + eta with
+// |eta| <= 2^-1075, and eta != 0 only for the product and the three FMAs of
+// a step (sums with a subnormal result are exact, so TwoSum stays exact);
+// carried through the derivation, each step errs by at most 4 (1 + u)^2K
+// 2^-1075 < 2^-1070 absolutely beyond the model, the per-operation margin
+// extended_cholesky.cc adds.
 
 #ifndef CERES_SESYNC_INTERNAL_DOUBLE_DOUBLE_H_
 #define CERES_SESYNC_INTERNAL_DOUBLE_DOUBLE_H_
@@ -119,13 +170,90 @@ inline DoubleDouble AccumulateSubtract(const DoubleDouble& x,
   return dd::TwoSum(s.hi, s.lo + (x.lo - y.lo));
 }
 
-// Joldes-Muller-Popescu Algorithm 12 (DWTimesDW3).
+// The correctly rounded double operations, for the *Parts functions below.
+// FmaAdd and FmaSub are a + b and a - b as well (rounded once: RN(a 1 + b) =
+// RN(a + b)), which SIMD code may compute with FMA instructions to use both
+// kinds of floating-point units.
+struct DoubleOps {
+  static double Add(double a, double b) { return a + b; }
+  static double Sub(double a, double b) { return a - b; }
+  static double FmaAdd(double a, double b) { return a + b; }
+  static double FmaSub(double a, double b) { return a - b; }
+  static double Fma(double a, double b, double c) { return std::fma(a, b, c); }
+};
+
+// The steps of SubtractProducts (bound in the file comment) on the parts of
+// double-doubles. `Real` is double or a SIMD vector of doubles, with
+// Ops::Add, Sub and Fma the correctly rounded a + b, a - b and a b + c (lane
+// by lane: extended_cholesky.cc's kernels; FmaAdd and FmaSub likewise). Every
+// type runs the same
+// operations in the same order, so results do not depend on the vector
+// width.
+//
+// One step: (T, t) <- (T, t) - x y, with (T, t) not renormalized.
+template <class Ops, class Real>
+[[gnu::always_inline]] inline void SubtractProductParts(Real x_hi, Real x_lo,
+                                                        Real y_hi, Real y_lo,
+                                                        Real* T, Real* t) {
+  const Real p = x_hi * y_hi;
+  const Real p_e = Ops::Fma(x_hi, y_hi, -p);  // Exact: x_hi y_hi = p + p_e.
+  const Real a = Ops::Fma(x_hi, y_lo, p_e);
+  const Real q = Ops::Fma(x_lo, y_hi, a);
+  // (S, e) = TwoSum(T, -p).
+  const Real S = Ops::Sub(*T, p);
+  const Real b = Ops::Sub(S, *T);
+  const Real e = Ops::Sub(Ops::FmaSub(*T, Ops::Sub(S, b)), Ops::FmaAdd(p, b));
+  *t = Ops::Add(e, Ops::Sub(*t, q));
+  *T = S;
+}
+
+// (T, t) <- TwoSum(T, t): the normalized double-double T + t.
+template <class Ops, class Real>
+[[gnu::always_inline]] inline void RenormalizeParts(Real* T, Real* t) {
+  const Real r = Ops::Add(*T, *t);
+  const Real c = Ops::Sub(r, *T);
+  *t = Ops::Add(Ops::Sub(*T, Ops::Sub(r, c)), Ops::Sub(*t, c));
+  *T = r;
+}
+
+// The largest number of products SubtractProducts' bound covers.
+constexpr int kMaxProducts = 8;
+
+// s - sum_{j<count} x[j] y[j] with one renormalization, count <=
+// kMaxProducts (bound in the file comment).
+inline DoubleDouble SubtractProducts(const DoubleDouble& s,
+                                     const DoubleDouble* x,
+                                     const DoubleDouble* y, int count) {
+  double T = s.hi, t = s.lo;
+  for (int j = 0; j < count; ++j) {
+    SubtractProductParts<DoubleOps>(x[j].hi, x[j].lo, y[j].hi, y[j].lo, &T, &t);
+  }
+  RenormalizeParts<DoubleOps>(&T, &t);
+  return {T, t};
+}
+
+// Joldes-Muller-Popescu Algorithm 12 (DWTimesDW3), on parts as above (the
+// kernels scale columns with it).
+template <class Ops, class Real>
+[[gnu::always_inline]] inline void MultiplyParts(Real x_hi, Real x_lo,
+                                                 Real y_hi, Real y_lo,
+                                                 Real* r_hi, Real* r_lo) {
+  const Real p = x_hi * y_hi;
+  const Real e = Ops::Fma(x_hi, y_hi, -p);  // TwoProduct.
+  const Real tl0 = x_lo * y_lo;
+  const Real tl1 = Ops::Fma(x_hi, y_lo, tl0);
+  const Real cl2 = Ops::Fma(x_lo, y_hi, tl1);
+  const Real b = Ops::Add(e, cl2);
+  // FastTwoSum(p, b).
+  const Real s = Ops::Add(p, b);
+  *r_lo = Ops::Sub(b, Ops::Sub(s, p));
+  *r_hi = s;
+}
+
 inline DoubleDouble operator*(const DoubleDouble& x, const DoubleDouble& y) {
-  const DoubleDouble c = dd::TwoProduct(x.hi, y.hi);
-  const double tl0 = x.lo * y.lo;
-  const double tl1 = std::fma(x.hi, y.lo, tl0);
-  const double cl2 = std::fma(x.lo, y.hi, tl1);
-  return dd::FastTwoSum(c.hi, c.lo + cl2);
+  DoubleDouble r;
+  MultiplyParts<DoubleOps>(x.hi, x.lo, y.hi, y.lo, &r.hi, &r.lo);
+  return r;
 }
 
 // 1 / x by one Newton step from the correctly rounded double reciprocal

@@ -1,7 +1,18 @@
+// The SIMD kernels pass GCC vector types between always-inlined functions
+// only; the ABI note about passing them by value does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
 #include "ceres_sesync/internal/extended_cholesky.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 #include "glog/logging.h"
 
@@ -20,6 +31,8 @@ bool Safe(const DoubleDouble& x) {
   const double a = std::abs(x.hi);
   return a == 0 || (a >= kSmallestSafeValue && a <= kLargestSafeValue);
 }
+
+// ---- The simplicial reference ---------------------------------------------
 
 // The numerical phase, cloned for CPUs with and without FMA instructions (the
 // FMA is std::fma either way, so results are identical; the clone only makes
@@ -78,7 +91,332 @@ __attribute__((target_clones("fma", "default"))) bool FactorizeRows(
   return true;
 }
 
+// ---- Dense kernels of the supernodal factorization ------------------------
+//
+// Double-double matrices are stored as two column-major arrays of doubles
+// (high and low parts) with a common leading dimension, so that W
+// consecutive rows load as one W-lane vector. The update kernel applies
+// SubtractProducts to each entry over the inner index in increasing order,
+// in blocks of kMaxProducts that depend only on the call; the lanes of a
+// vector are independent entries, so the vectorized and the portable
+// instantiations compute bitwise the same results.
+
+// Lanes: the portable scalar, and 4 doubles (AVX2), with the operations
+// SubtractProductParts takes.
+struct ScalarLanes : DoubleOps {
+  using Real = double;
+  static constexpr int kWidth = 1;
+  [[gnu::always_inline]] static Real Load(const double* p) { return *p; }
+  [[gnu::always_inline]] static void Store(double* p, Real v) { *p = v; }
+  [[gnu::always_inline]] static Real Broadcast(const double* p) { return *p; }
+};
+
+// 4 lanes as a GCC/Clang vector type: plain code (inlined into functions
+// compiled for AVX2 + FMA, where each operation is one instruction).
+typedef double Vector4 __attribute__((vector_size(32)));
+
+struct Lanes4 {
+  using Real = Vector4;
+  static constexpr int kWidth = 4;
+  [[gnu::always_inline]] static Real Load(const double* p) {
+    Real v;
+    std::memcpy(&v, p, sizeof(v));
+    return v;
+  }
+  [[gnu::always_inline]] static void Store(double* p, Real v) {
+    std::memcpy(p, &v, sizeof(v));
+  }
+  [[gnu::always_inline]] static Real Broadcast(const double* p) {
+    const double x = *p;
+    return Real{x, x, x, x};
+  }
+  [[gnu::always_inline]] static Real Add(Real a, Real b) { return a + b; }
+  [[gnu::always_inline]] static Real Sub(Real a, Real b) { return a - b; }
+  // Lane by lane; one vfmadd with FMA enabled.
+  [[gnu::always_inline]] static Real Fma(Real a, Real b, Real c) {
+    Real r;
+    for (int i = 0; i < kWidth; ++i) r[i] = std::fma(a[i], b[i], c[i]);
+    return r;
+  }
+  // a + b and a - b as a 1 + b and a 1 - b: the same rounding, on the FMA
+  // units (the additions alone would saturate the adder units).
+  [[gnu::always_inline]] static Real FmaAdd(Real a, Real b) {
+    return Fma(a, Real{1, 1, 1, 1}, b);
+  }
+  [[gnu::always_inline]] static Real FmaSub(Real a, Real b) {
+    return Fma(a, Real{1, 1, 1, 1}, -b);
+  }
+};
+
+// C(i, j) <- C(i, j) - sum_l A(i, l) B(j, l), l = 0 .. k-1 in order, for
+// 0 <= j < n and j <= i < m (m >= n): row i of A and of C and row j of B are
+// the same local index space, as for the rows of a supernode. Every entry
+// is computed by SubtractProducts over l = 0..K-1, K..2K-1, ...
+// (K = kMaxProducts; the blocks restart at l = 0 in every call). Entries
+// above the diagonal in the leading rows of each block of columns
+// (j0 <= i < j) are computed as well, from and into C's storage there, which
+// the callers never read.
+struct UpdateBlock {
+  const double *a_hi, *a_lo;
+  int lda;
+  const double *b_hi, *b_lo;
+  int ldb;
+  double *c_hi, *c_lo;
+  int ldc;
+  int m, n, k;
+};
+
+constexpr int kInnerChunk = 32 * kMaxProducts;  // l per pass (cache reuse).
+constexpr int kRowChunk = 128;                  // Rows per pass.
+constexpr int kColumnBlock = 4;                 // Columns per tile (at most).
+static_assert(kInnerChunk % kMaxProducts == 0, "blocks must not straddle");
+
+// A kRows W x kColumns tile of C (at c, leading dimension ldc) minus `count`
+// products of A's rows (at a: A(i, l) = a[i + l lda]) and B's (b[j + l ldb]),
+// in blocks of kMaxProducts from the first: the accumulators stay in
+// registers.
+template <class Lanes, int kRows, int kColumns>
+[[gnu::always_inline]] inline void UpdateTile(const double* a_hi,
+                                              const double* a_lo, int lda,
+                                              const double* b_hi,
+                                              const double* b_lo, int ldb,
+                                              double* c_hi, double* c_lo,
+                                              int ldc, int count) {
+  using Real = typename Lanes::Real;
+  constexpr int W = Lanes::kWidth;
+  Real T[kRows][kColumns], t[kRows][kColumns];
+#pragma GCC unroll 4
+  for (int c = 0; c < kColumns; ++c) {
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) {
+      T[r][c] = Lanes::Load(c_hi + r * W + c * ldc);
+      t[r][c] = Lanes::Load(c_lo + r * W + c * ldc);
+    }
+  }
+  for (int lb = 0; lb < count; lb += kMaxProducts) {
+    const int le = std::min(count, lb + kMaxProducts);
+    for (int l = lb; l < le; ++l) {
+      Real x_hi[kRows], x_lo[kRows];
+#pragma GCC unroll 4
+      for (int r = 0; r < kRows; ++r) {
+        x_hi[r] = Lanes::Load(a_hi + l * lda + r * W);
+        x_lo[r] = Lanes::Load(a_lo + l * lda + r * W);
+      }
+#pragma GCC unroll 4
+      for (int c = 0; c < kColumns; ++c) {
+        const Real y_hi = Lanes::Broadcast(b_hi + l * ldb + c);
+        const Real y_lo = Lanes::Broadcast(b_lo + l * ldb + c);
+#pragma GCC unroll 4
+        for (int r = 0; r < kRows; ++r) {
+          SubtractProductParts<Lanes>(x_hi[r], x_lo[r], y_hi, y_lo, &T[r][c],
+                                      &t[r][c]);
+        }
+      }
+    }
+#pragma GCC unroll 4
+    for (int c = 0; c < kColumns; ++c) {
+#pragma GCC unroll 4
+      for (int r = 0; r < kRows; ++r) {
+        RenormalizeParts<Lanes>(&T[r][c], &t[r][c]);
+      }
+    }
+  }
+#pragma GCC unroll 4
+  for (int c = 0; c < kColumns; ++c) {
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) {
+      Lanes::Store(c_hi + r * W + c * ldc, T[r][c]);
+      Lanes::Store(c_lo + r * W + c * ldc, t[r][c]);
+    }
+  }
+}
+
+// Columns j0 .. j0 + kColumns - 1, rows [max(j0, i0), i1), l in [l0, l1):
+// tiles of kRows vectors (several independent accumulators per column hide
+// the latency of each one's chain), then single vectors; the last rows
+// (fewer than W) are copied into zero-padded buffers for one more vector
+// tile (lanes are independent: the same operations as on their own).
+template <class Lanes, int kColumns>
+[[gnu::always_inline]] inline void UpdateColumns(const UpdateBlock& u, int j0,
+                                                 int i0, int i1, int l0,
+                                                 int l1) {
+  constexpr int W = Lanes::kWidth;
+  constexpr int kRows = kColumns >= 3 ? 2 : 4;
+  const int count = l1 - l0;
+  const long long a0 = static_cast<long long>(l0) * u.lda;
+  const double* b_hi = u.b_hi + static_cast<long long>(l0) * u.ldb + j0;
+  const double* b_lo = u.b_lo + static_cast<long long>(l0) * u.ldb + j0;
+  const long long c0 = static_cast<long long>(j0) * u.ldc;
+  int i = std::max(i0, j0);
+  for (; i + kRows * W <= i1; i += kRows * W) {
+    UpdateTile<Lanes, kRows, kColumns>(u.a_hi + a0 + i, u.a_lo + a0 + i, u.lda,
+                                       b_hi, b_lo, u.ldb, u.c_hi + c0 + i,
+                                       u.c_lo + c0 + i, u.ldc, count);
+  }
+  for (; i + W <= i1; i += W) {
+    UpdateTile<Lanes, 1, kColumns>(u.a_hi + a0 + i, u.a_lo + a0 + i, u.lda,
+                                   b_hi, b_lo, u.ldb, u.c_hi + c0 + i,
+                                   u.c_lo + c0 + i, u.ldc, count);
+  }
+  const int rest = i1 - i;
+  if (rest > 0) {
+    double pa_hi[kInnerChunk * W], pa_lo[kInnerChunk * W];
+    double pc_hi[kColumns * W], pc_lo[kColumns * W];
+    for (int l = 0; l < count; ++l) {
+      for (int r = 0; r < W; ++r) {
+        const bool in = r < rest;
+        const long long q = a0 + static_cast<long long>(l) * u.lda + i + r;
+        pa_hi[l * W + r] = in ? u.a_hi[q] : 0;
+        pa_lo[l * W + r] = in ? u.a_lo[q] : 0;
+      }
+    }
+    for (int c = 0; c < kColumns; ++c) {
+      for (int r = 0; r < W; ++r) {
+        const bool in = r < rest;
+        const long long q = c0 + static_cast<long long>(c) * u.ldc + i + r;
+        pc_hi[c * W + r] = in ? u.c_hi[q] : 0;
+        pc_lo[c * W + r] = in ? u.c_lo[q] : 0;
+      }
+    }
+    UpdateTile<Lanes, 1, kColumns>(pa_hi, pa_lo, W, b_hi, b_lo, u.ldb, pc_hi,
+                                   pc_lo, W, count);
+    for (int c = 0; c < kColumns; ++c) {
+      for (int r = 0; r < rest; ++r) {
+        const long long q = c0 + static_cast<long long>(c) * u.ldc + i + r;
+        u.c_hi[q] = pc_hi[c * W + r];
+        u.c_lo[q] = pc_lo[c * W + r];
+      }
+    }
+  }
+}
+
+template <class Lanes>
+[[gnu::always_inline]] inline void Update(const UpdateBlock& u) {
+  for (int l0 = 0; l0 < u.k; l0 += kInnerChunk) {
+    const int l1 = std::min(u.k, l0 + kInnerChunk);
+    for (int i0 = 0; i0 < u.m; i0 += kRowChunk) {
+      const int i1 = std::min(u.m, i0 + kRowChunk);
+      for (int j0 = 0; j0 < std::min(u.n, i1); j0 += kColumnBlock) {
+        switch (std::min(kColumnBlock, u.n - j0)) {
+          case 4:
+            UpdateColumns<Lanes, 4>(u, j0, i0, i1, l0, l1);
+            break;
+          case 3:
+            UpdateColumns<Lanes, 3>(u, j0, i0, i1, l0, l1);
+            break;
+          case 2:
+            UpdateColumns<Lanes, 2>(u, j0, i0, i1, l0, l1);
+            break;
+          default:
+            UpdateColumns<Lanes, 1>(u, j0, i0, i1, l0, l1);
+        }
+      }
+    }
+  }
+}
+
+// x(i) <- x(i) * y for i < m (DoubleDouble's operator*, lane by lane).
+template <class Lanes>
+[[gnu::always_inline]] inline void Scale(int m, double* x_hi, double* x_lo,
+                                         double y_hi, double y_lo) {
+  using Real = typename Lanes::Real;
+  constexpr int W = Lanes::kWidth;
+  const Real yh = Lanes::Broadcast(&y_hi), yl = Lanes::Broadcast(&y_lo);
+  int i = 0;
+  for (; i + W <= m; i += W) {
+    Real r_hi, r_lo;
+    MultiplyParts<Lanes>(Lanes::Load(x_hi + i), Lanes::Load(x_lo + i), yh, yl,
+                         &r_hi, &r_lo);
+    Lanes::Store(x_hi + i, r_hi);
+    Lanes::Store(x_lo + i, r_lo);
+  }
+  for (; i < m; ++i) {
+    MultiplyParts<ScalarLanes>(x_hi[i], x_lo[i], y_hi, y_lo, x_hi + i,
+                               x_lo + i);
+  }
+}
+
+void UpdatePortable(const UpdateBlock& u) { Update<ScalarLanes>(u); }
+void ScalePortable(int m, double* x_hi, double* x_lo, double y_hi,
+                   double y_lo) {
+  Scale<ScalarLanes>(m, x_hi, x_lo, y_hi, y_lo);
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx2,fma"))) void UpdateAvx2(const UpdateBlock& u) {
+  Update<Lanes4>(u);
+}
+__attribute__((target("avx2,fma"))) void ScaleAvx2(int m, double* x_hi,
+                                                   double* x_lo, double y_hi,
+                                                   double y_lo) {
+  Scale<Lanes4>(m, x_hi, x_lo, y_hi, y_lo);
+}
+bool HaveAvx2() {
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+#else
+void UpdateAvx2(const UpdateBlock& u) { UpdatePortable(u); }
+void ScaleAvx2(int m, double* x_hi, double* x_lo, double y_hi, double y_lo) {
+  ScalePortable(m, x_hi, x_lo, y_hi, y_lo);
+}
+bool HaveAvx2() { return false; }
+#endif
+
+// The kernels of one instruction set.
+struct Kernels {
+  void (*update)(const UpdateBlock&);
+  void (*scale)(int m, double* x_hi, double* x_lo, double y_hi, double y_lo);
+};
+
+// Factors one supernode in place after all updates from below: its nrows x
+// ncols block X (column-major, leading dimension nrows, hi/lo parts), with
+// the diagonal block on top. Panels of kPanel columns: each panel first
+// receives the update of the supernode's earlier columns (one large
+// Update), then its columns are finished one by one (the update of the
+// panel's earlier columns, the pivot, the scaling). Returns false on a pivot
+// that is not positive or not safe.
+constexpr int kPanel = 32;
+
+bool FactorSupernode(const Kernels& kernels, int nrows, int ncols, double* hi,
+                     double* lo) {
+  const int ld = nrows;
+  // Entry (i, j) of the block.
+  auto at = [ld](double* x, int i, int j) {
+    return x + i + static_cast<long long>(j) * ld;
+  };
+  for (int c0 = 0; c0 < ncols; c0 += kPanel) {
+    const int c1 = std::min(ncols, c0 + kPanel);
+    if (c0 > 0) {
+      kernels.update({hi + c0, lo + c0, ld, hi + c0, lo + c0, ld,
+                      at(hi, c0, c0), at(lo, c0, c0), ld, nrows - c0, c1 - c0,
+                      c0});
+    }
+    for (int j = c0; j < c1; ++j) {
+      double* x_hi = at(hi, 0, j);
+      double* x_lo = at(lo, 0, j);
+      if (j > c0) {
+        kernels.update({at(hi, j, c0), at(lo, j, c0), ld, at(hi, j, c0),
+                        at(lo, j, c0), ld, x_hi + j, x_lo + j, ld, nrows - j, 1,
+                        j - c0});
+      }
+      const DoubleDouble d(x_hi[j], x_lo[j]);
+      if (!(d.hi > 0) || !Safe(d)) return false;
+      const DoubleDouble l_jj = Sqrt(d);
+      const DoubleDouble inverse = Reciprocal(l_jj);
+      x_hi[j] = l_jj.hi;
+      x_lo[j] = l_jj.lo;
+      kernels.scale(nrows - j - 1, x_hi + j + 1, x_lo + j + 1, inverse.hi,
+                    inverse.lo);
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+DoubleDoubleCholesky::DoubleDoubleCholesky(const Options& options)
+    : options_(options),
+      vectorized_(options.supernodal && options.vectorize && HaveAvx2()) {}
 
 void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
                                    std::vector<int> row_index) {
@@ -122,12 +460,220 @@ void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
   factor_row_.resize(factor_start_[n]);
   factor_value_.resize(factor_start_[n]);
   factorized_ = false;
+  super_start_.clear();
+  super_row_start_.clear();
+  super_row_.clear();
+  super_value_start_.clear();
+  if (options_.supernodal) AnalyzeSupernodes();
+}
+
+void DoubleDoubleCholesky::AnalyzeSupernodes() {
+  const int n = n_;
+  // The pattern of L by columns (rows increasing, diagonal first), by the
+  // same up-looking pass as the simplicial factorization.
+  {
+    std::vector<int> next(factor_start_.begin(), factor_start_.end() - 1);
+    std::vector<int> mark(n, -1);
+    for (int k = 0; k < n; ++k) {
+      factor_row_[next[k]++] = k;
+      mark[k] = k;
+      for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
+        for (int i = row_index_[p]; mark[i] != k; i = parent_[i]) {
+          mark[i] = k;
+          factor_row_[next[i]++] = k;
+        }
+      }
+    }
+  }
+  // Fundamental supernodes: column j + 1 continues column j's supernode iff
+  // it is j's parent and has j's pattern minus j.
+  auto count = [&](int j) { return factor_start_[j + 1] - factor_start_[j]; };
+  super_start_.push_back(0);
+  for (int j = 1; j < n; ++j) {
+    if (!(parent_[j - 1] == j && count(j - 1) == count(j) + 1)) {
+      super_start_.push_back(j);
+    }
+  }
+  if (n > 0) super_start_.push_back(n);
+  const int num_super = num_supernodes();
+  column_super_.resize(n);
+  super_row_start_.assign(1, 0);
+  super_value_start_.assign(1, 0);
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s];
+    const int ncols = super_start_[s + 1] - first;
+    for (int j = first; j < first + ncols; ++j) column_super_[j] = s;
+    super_row_.insert(super_row_.end(),
+                      factor_row_.begin() + factor_start_[first],
+                      factor_row_.begin() + factor_start_[first + 1]);
+    super_row_start_.push_back(static_cast<int>(super_row_.size()));
+    const long long nrows = count(first);
+    super_value_start_.push_back(super_value_start_.back() + nrows * ncols);
+  }
+  // Where each input value goes: entry (k, i), k >= i, of A is in the column
+  // of supernode s = column_super_[i], at the position of row k.
+  value_destination_.assign(row_index_.size(), -1);
+  std::vector<int> lower_start(n + 1, 0);
+  for (int k = 0; k < n; ++k) {
+    for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
+      ++lower_start[row_index_[p] + 1];
+    }
+  }
+  for (int i = 0; i < n; ++i) lower_start[i + 1] += lower_start[i];
+  std::vector<int> lower_row(row_index_.size()), lower_value(row_index_.size());
+  {
+    std::vector<int> next(lower_start.begin(), lower_start.end() - 1);
+    for (int k = 0; k < n; ++k) {
+      for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
+        const int slot = next[row_index_[p]]++;
+        lower_row[slot] = k;
+        lower_value[slot] = p;
+      }
+    }
+  }
+  std::vector<int> position(n, -1);
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s];
+    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const int* rows = super_row_.data() + super_row_start_[s];
+    for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
+    for (int j = first; j < super_start_[s + 1]; ++j) {
+      for (int q = lower_start[j]; q < lower_start[j + 1]; ++q) {
+        value_destination_[lower_value[q]] =
+            super_value_start_[s] + static_cast<long long>(j - first) * nrows +
+            position[lower_row[q]];
+      }
+    }
+  }
+}
+
+bool DoubleDoubleCholesky::FactorizeSupernodal(
+    const std::vector<DoubleDouble>& values) {
+  const int num_super = num_supernodes();
+  const Kernels kernels = vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2}
+                                      : Kernels{UpdatePortable, ScalePortable};
+  // The dense blocks (only for the factorization: L is copied out).
+  std::vector<double> super_hi(supernodal_entries(), 0.0);
+  std::vector<double> super_lo(supernodal_entries(), 0.0);
+  for (size_t p = 0; p < values.size(); ++p) {
+    // Renormalized (the same value): the kernels' bounds assume it.
+    const DoubleDouble v = dd::TwoSum(values[p].hi, values[p].lo);
+    super_hi[value_destination_[p]] = v.hi;
+    super_lo[value_destination_[p]] = v.lo;
+  }
+  // Left-looking: supernode d, once factored, waits in the list of the
+  // supernode holding its next row below the ones already applied
+  // (pointer[d]), which it updates when that one's turn comes.
+  std::vector<int> head(num_super, -1), next(num_super, -1);
+  std::vector<int> pointer(num_super, 0), position(n_, -1);
+  std::vector<int> relative;
+  std::vector<double> work_hi, work_lo;
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s], last = super_start_[s + 1];
+    const int ncols = last - first;
+    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const int* rows = super_row_.data() + super_row_start_[s];
+    double* s_hi = super_hi.data() + super_value_start_[s];
+    double* s_lo = super_lo.data() + super_value_start_[s];
+    for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
+    for (int d = head[s]; d != -1;) {
+      const int d_next = next[d];
+      const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
+      const int* d_rows = super_row_.data() + super_row_start_[d];
+      const int p1 = pointer[d];
+      int p2 = p1;
+      while (p2 < d_nrows && d_rows[p2] < last) ++p2;
+      const int m = d_nrows - p1, n = p2 - p1;
+      const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
+      const double* d_lo = super_lo.data() + super_value_start_[d] + p1;
+      const int k = super_start_[d + 1] - super_start_[d];
+      // The target rows of d's rows p1.. are contiguous in s (positions
+      // increase with the rows): update s in place; otherwise gather the
+      // target entries, update, scatter.
+      const int r0 = position[d_rows[p1]];
+      if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
+        kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                        s_hi + r0 + static_cast<long long>(r0) * nrows,
+                        s_lo + r0 + static_cast<long long>(r0) * nrows, nrows,
+                        m, n, k});
+      } else {
+        relative.resize(m);
+        for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
+        const size_t size = static_cast<size_t>(m) * n;
+        if (work_hi.size() < size) {
+          work_hi.resize(size);
+          work_lo.resize(size);
+        }
+        for (int j = 0; j < n; ++j) {
+          const double* t_hi =
+              s_hi + static_cast<long long>(relative[j]) * nrows;
+          const double* t_lo =
+              s_lo + static_cast<long long>(relative[j]) * nrows;
+          double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+          double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+          // Zeros above the diagonal where the kernel computes unused
+          // entries (from the start of j's block of columns).
+          for (int i = j - j % kColumnBlock; i < j; ++i) w_hi[i] = w_lo[i] = 0;
+          for (int i = j; i < m; ++i) {
+            w_hi[i] = t_hi[relative[i]];
+            w_lo[i] = t_lo[relative[i]];
+          }
+        }
+        kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                        work_hi.data(), work_lo.data(), m, m, n, k});
+        for (int j = 0; j < n; ++j) {
+          double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
+          double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
+          const double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+          const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+          for (int i = j; i < m; ++i) {
+            t_hi[relative[i]] = w_hi[i];
+            t_lo[relative[i]] = w_lo[i];
+          }
+        }
+      }
+      pointer[d] = p2;
+      if (p2 < d_nrows) {
+        const int target = column_super_[d_rows[p2]];
+        next[d] = head[target];
+        head[target] = d;
+      }
+      d = d_next;
+    }
+    if (!FactorSupernode(kernels, nrows, ncols, s_hi, s_lo)) return false;
+    pointer[s] = ncols;
+    if (ncols < nrows) {
+      const int target = column_super_[rows[ncols]];
+      next[s] = head[target];
+      head[target] = s;
+    }
+  }
+  // L in compressed columns.
+  for (int s = 0; s < num_super; ++s) {
+    const int first = super_start_[s];
+    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const double* s_hi = super_hi.data() + super_value_start_[s];
+    const double* s_lo = super_lo.data() + super_value_start_[s];
+    for (int j = first; j < super_start_[s + 1]; ++j) {
+      const long long offset =
+          static_cast<long long>(j - first) * nrows + (j - first);
+      for (int p = factor_start_[j]; p < factor_start_[j + 1]; ++p) {
+        const long long t = offset + (p - factor_start_[j]);
+        factor_value_[p] = DoubleDouble(s_hi[t], s_lo[t]);
+      }
+    }
+  }
+  return true;
 }
 
 bool DoubleDoubleCholesky::Factorize(const std::vector<DoubleDouble>& values) {
   CHECK_EQ(values.size(), row_index_.size());
   for (const DoubleDouble& v : values) {
     if (!Safe(v)) return factorized_ = false;
+  }
+  if (options_.supernodal) {
+    factorized_ = FactorizeSupernodal(values);
+    return factorized_;
   }
   std::vector<int> fill(n_);
   factorized_ =

@@ -2,13 +2,10 @@
 // (double_double.h), with a rigorous bound on its backward error: the proof
 // engine for certificates that double precision cannot resolve.
 //
-// The factorization is the up-looking (row by row) scheme: row k of L solves
-// L(0:k-1, 0:k-1) l_k = A(0:k-1, k) over the elimination-tree reach of
-// A(:, k), then l_kk = sqrt(a_kk - l_k^T l_k) (Davis, "Direct Methods for
-// Sparse Linear Systems", SIAM 2006, Sec. 4.2). Every computed entry obeys
-// the componentwise backward-error bound of Higham ("Accuracy and
-// Stability of Numerical Algorithms", 2nd ed., Thm. 10.3 with Lemma 8.4: any
-// summation order) in any arithmetic satisfying the standard model:
+// Every computed entry obeys the componentwise backward-error bound of Higham
+// ("Accuracy and Stability of Numerical Algorithms", 2nd ed., Thm. 10.3 with
+// Lemma 8.4: any summation order) in any arithmetic satisfying the standard
+// model (or the Cray-style model of double_double.h):
 //
 //   L L^T = A + E,   |E| <= gamma_{k+1} |L| |L^T|,
 //
@@ -17,6 +14,26 @@
 // therefore proves A + E positive semidefinite, i.e. A + diag(rho) >= 0 for
 // the Gershgorin row sums rho_i >= sum_j |E_ij| returned by
 // RowBackwardErrorBounds().
+//
+// Two numerical schemes compute each l_ij = (a_ij - sum_k l_ik l_jk) / l_jj
+// (l_jj = sqrt(a_jj - sum_k l_jk^2)) over the nonzero terms, in different
+// orders of summation, so the bound holds for both:
+//  - supernodal (the default): left-looking over supernodes, i.e. sets of
+//    consecutive columns with the same pattern below their diagonal block,
+//    stored as dense column-major blocks (Ng and Peyton, SIAM J. Sci. Comput.
+//    14(5), 1993; Davis, "Direct Methods for Sparse Linear Systems", SIAM
+//    2006, Ch. 4). Each supernode receives the updates of the supernodes
+//    below it, C -= A B^T, then factors its diagonal block and scales its
+//    off-diagonal block, in panels of columns. The inner products run in
+//    SubtractProducts steps (double_double.h: one renormalization per 8
+//    products, within the same Cray-style model), vectorized over rows with
+//    AVX2+FMA when the CPU has them: bitwise the same results as the
+//    portable code, since each entry sees the same operations in the same
+//    order and the lanes are independent entries.
+//  - simplicial: the up-looking (row by row) scheme (Davis Ch. 4), kept as
+//    the reference.
+// Results do not depend on the machine (std::fma is correctly rounded in
+// hardware or in software; the file is compiled with -ffp-contract=off).
 //
 // The matrix is given already permuted (the caller chooses the fill-reducing
 // ordering), as the upper triangle in compressed columns.
@@ -32,9 +49,20 @@ namespace ceres_sesync::internal {
 
 class DoubleDoubleCholesky {
  public:
+  struct Options {
+    // Supernodal (dense kernels) or the simplicial up-looking reference.
+    bool supernodal = true;
+    // Use the SIMD kernels when the CPU has AVX2 and FMA. The results are
+    // bitwise identical either way (tests compare); false is for testing.
+    bool vectorize = true;
+  };
+
+  DoubleDoubleCholesky() : DoubleDoubleCholesky(Options()) {}
+  explicit DoubleDoubleCholesky(const Options& options);
+
   // Symbolic analysis of the n x n pattern: column k of the upper triangle
   // holds the rows row_index[column_start[k] .. column_start[k+1]) (each
-  // <= k; the diagonal must be present). O(nnz(L)).
+  // <= k, no duplicates; the diagonal must be present). O(nnz(L)).
   void Analyze(int n, std::vector<int> column_start,
                std::vector<int> row_index);
 
@@ -62,8 +90,26 @@ class DoubleDoubleCholesky {
   }
   // Multiply-adds of one factorization: sum over columns of count^2 / 2.
   double flops() const { return flops_; }
+  // After Analyze(), supernodal: the supernodes and their stored entries
+  // (dense blocks, including the explicit zeros of merged supernodes and
+  // the unused upper triangles of the diagonal blocks).
+  // Supernode s holds columns supernode_start()[s] .. [s + 1] - 1.
+  const std::vector<int>& supernode_start() const { return super_start_; }
+  int num_supernodes() const {
+    return super_start_.empty() ? 0 : static_cast<int>(super_start_.size()) - 1;
+  }
+  long long supernodal_entries() const {
+    return super_value_start_.empty() ? 0 : super_value_start_.back();
+  }
+  // Whether Factorize() uses the SIMD kernels.
+  bool vectorized() const { return vectorized_; }
 
  private:
+  void AnalyzeSupernodes();
+  bool FactorizeSupernodal(const std::vector<DoubleDouble>& values);
+
+  Options options_;
+  bool vectorized_ = false;
   int n_ = 0;
   std::vector<int> column_start_, row_index_;  // The upper triangle of A.
   std::vector<int> parent_;                    // Elimination tree.
@@ -73,6 +119,14 @@ class DoubleDoubleCholesky {
   std::vector<int> row_count_;                 // Entries per row of L.
   double flops_ = 0;
   bool factorized_ = false;
+  // Supernodes: columns super_start_[s] .. super_start_[s+1] - 1, rows
+  // super_row_[super_row_start_[s] ..] (increasing, its columns first), values
+  // (column-major, leading dimension = its row count) at
+  // super_value_start_[s] in the dense blocks of FactorizeSupernodal().
+  std::vector<int> super_start_, super_row_start_, super_row_;
+  std::vector<long long> super_value_start_;
+  std::vector<int> column_super_;             // Supernode of each column.
+  std::vector<long long> value_destination_;  // Input value -> block entry.
 };
 
 }  // namespace ceres_sesync::internal
