@@ -28,7 +28,7 @@ class DoubleDoubleCholesky;
 // The arithmetic of a proof's factorization.
 enum class ProofPrecision {
   kDouble,        // CHOLMOD in double: fast; resolves ~1e-16 of K's scale.
-  kDoubleDouble,  // extended_cholesky.h: ~1e-31 of K's scale, 3-7x slower.
+  kDoubleDouble,  // extended_cholesky.h: ~1e-31 of K's scale, 1-3.4x slower.
 };
 const char* ProofPrecisionName(ProofPrecision precision);
 
