@@ -175,8 +175,12 @@ std::string Certificate::FullReport() const {
   } else {
     line("%-36s %.3e\n", "lambda_min(S) estimate", lambda_min);
   }
-  line("%-36s %.3e (proof in %s, all round-off included)\n",
-       "eta (S + eta I proven PSD)", eta, proof_precision.c_str());
+  if (std::isfinite(eta)) {
+    line("%-36s %.3e (proof in %s, all round-off included)\n",
+         "eta (S + eta I proven PSD)", eta, proof_precision.c_str());
+  } else {
+    line("%-36s %s\n", "eta (S + eta I proven PSD)", "none proven");
+  }
   line("%-36s %d double, %d double-double (%.4f s)\n",
        "Certificate factorizations", factorizations, extended_factorizations,
        extended_proof_time_s);

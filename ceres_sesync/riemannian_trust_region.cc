@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 namespace ceres_sesync {
@@ -25,7 +26,8 @@ struct TcgResult {
 // reference_norm (the gradient norm at the start of the solve).
 TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
                       RiemannianCostFunction* cost, const Eigen::MatrixXd& g,
-                      double radius, double reference_norm) {
+                      double radius, double reference_norm,
+                      const std::function<bool()>& out_of_time) {
   TcgResult out;
   out.eta.setZero(g.rows(), g.cols());
   out.h_eta.setZero(g.rows(), g.cols());
@@ -62,6 +64,9 @@ TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
     r += alpha * h_delta;
     cost->ProjectToTangent(r, &r);
     if (std::sqrt(Inner(r, r)) <= target) return out;
+    // At the time limit the step so far (a descent step of the model: every
+    // CG iterate decreases it) is taken as it is.
+    if (out_of_time()) return out;
     cost->Precondition(r, &z);
     const double z_r_old = z_r;
     z_r = Inner(z, r);
@@ -148,7 +153,9 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
     // Inner solve, then shrink the radius until a step is accepted.
     for (;;) {
       const TcgResult step =
-          TruncatedCg(options, cost, g, radius, reference_norm);
+          TruncatedCg(options, cost, g, radius, reference_norm, [&] {
+            return options.max_time_s > 0 && elapsed() >= options.max_time_s;
+          });
       summary->hessian_vector_products += step.iterations;
       const double model_decrease =
           -(Inner(g, step.eta) + 0.5 * Inner(step.eta, step.h_eta));

@@ -112,8 +112,12 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %.3e\n", "Suboptimality bound", suboptimality_bound);
   line("%-34s %.3e\n", "Relative suboptimality bound",
        relative_suboptimality_bound);
-  line("%-34s %.3e (proof in %s, all round-off included)\n",
-       "eta (S + eta I proven PSD)", eta, proof_precision.c_str());
+  if (std::isfinite(eta)) {
+    line("%-34s %.3e (proof in %s, all round-off included)\n",
+         "eta (S + eta I proven PSD)", eta, proof_precision.c_str());
+  } else {
+    line("%-34s %s\n", "eta (S + eta I proven PSD)", "none proven");
+  }
   line("%-34s %s\n", "Relaxation exact",
        relaxation_exact ? "yes" : "no (rounding gap or rank)");
   if (std::isnan(lambda_min_estimate)) {

@@ -12,6 +12,7 @@
 
 #include "ceres_sesync/internal/certificate_matrix.h"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -399,6 +400,32 @@ TEST_F(CertificateTest, VerifyCertificateAgreesWithDenseSpectrum) {
     }
   }
   EXPECT_GT(vacuous, 0);  // The random points exercise the shortcut.
+}
+
+// A deadline that has passed stops the verification before any
+// factorization: nothing is proven (eta = +inf), out_of_time says why, and
+// no certificate is claimed.
+TEST_F(CertificateTest, VerificationStopsAtItsDeadline) {
+  Build(Graphs()[0]);
+  CertificateMatrix matrix(*problem_);
+  const Instance& in = instances_[0];  // The optimum.
+  internal::VerificationOptions options;
+  options.eta_target = 1e-9 * in.f / (in.d * in.n);
+  options.eta_goal = 1e-6 * in.f / (in.d * in.n);
+  options.eta_max = 1e-3 * in.f / (in.d * in.n);
+  options.deadline = std::chrono::steady_clock::now();
+  const VerificationResult late =
+      internal::VerifyCertificate(*problem_, in.Lambda, options, &matrix);
+  EXPECT_TRUE(late.out_of_time);
+  EXPECT_FALSE(late.certified);
+  EXPECT_TRUE(std::isinf(late.eta));
+  EXPECT_EQ(late.factorizations + late.extended_factorizations, 0);
+  // Without the deadline the same verification certifies.
+  options.deadline = std::chrono::steady_clock::time_point::max();
+  const VerificationResult on_time =
+      internal::VerifyCertificate(*problem_, in.Lambda, options, &matrix);
+  EXPECT_FALSE(on_time.out_of_time);
+  EXPECT_TRUE(on_time.certified);
 }
 
 }  // namespace

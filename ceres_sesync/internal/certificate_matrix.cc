@@ -156,18 +156,33 @@ void CertificateMatrix::Assemble(const Eigen::MatrixXd& Lambda, double c,
   }
 }
 
+double CertificateMatrix::PredictedSeconds(ProofPrecision precision) const {
+  if (precision == ProofPrecision::kDouble) return last_double_seconds_;
+  return last_extended_seconds_ > 0 ? last_extended_seconds_
+                                    : 3.4 * last_double_seconds_;
+}
+
+void CertificateMatrix::FactorizeDouble() {
+  const auto start = std::chrono::steady_clock::now();
+  ++double_factorizations_;
+  factor_.factorize(K_);
+  last_double_seconds_ =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+}
+
 bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c) {
   std::vector<double> unused;
   Assemble(Lambda, c, 0, &unused);
   factorized_shift_ = 0;
-  ++double_factorizations_;
-  factor_.factorize(K_);
+  FactorizeDouble();
   return factor_.info() == Eigen::Success;
 }
 
 bool CertificateMatrix::Prove(const Eigen::MatrixXd& Lambda, double c,
                               ProofPrecision precision) {
   proven_shift_ = backward_error_ = std::numeric_limits<double>::infinity();
+  timed_out_ = false;
   return precision == ProofPrecision::kDouble ? ProveDouble(Lambda, c)
                                               : ProveDoubleDouble(Lambda, c);
 }
@@ -185,8 +200,7 @@ bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
     std::vector<double> rounding, rho;
     Assemble(Lambda, c, mu, &rounding);
     factorized_shift_ = mu;
-    ++double_factorizations_;
-    factor_.factorize(K_);
+    FactorizeDouble();
     if (factor_.info() != Eigen::Success) return false;
     factor_.RowBackwardErrorBounds(&rho);
     double head = 0, tail = 0;
@@ -334,7 +348,15 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
       }
     }
     ++extended_factorizations_;
-    if (!extended_->Factorize(values)) return false;
+    const auto start = std::chrono::steady_clock::now();
+    const bool factorized = extended_->Factorize(values, deadline_);
+    timed_out_ = extended_->timed_out();
+    if (!timed_out_) {
+      last_extended_seconds_ = std::chrono::duration<double>(
+                                   std::chrono::steady_clock::now() - start)
+                                   .count();
+    }
+    if (!factorized) return false;
     std::vector<double> rho;
     extended_->RowBackwardErrorBounds(&rho);
     double head = 0, tail = 0;

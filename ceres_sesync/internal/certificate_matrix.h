@@ -16,6 +16,7 @@
 #ifndef CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 #define CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -82,6 +83,19 @@ class CertificateMatrix {
   // The mu the next double proof starts with (adapted from the last one).
   double next_double_shift() const { return double_shift_; }
 
+  // A time limit for the factorizations (none by default): a double-double
+  // factorization stops when it passes (Prove() then returns false and
+  // timed_out() is true); CHOLMOD's cannot be interrupted, so callers ask
+  // PredictedSeconds() first.
+  void set_deadline(std::chrono::steady_clock::time_point deadline) {
+    deadline_ = deadline;
+  }
+  bool timed_out() const { return timed_out_; }
+  // Seconds the next factorization in `precision` is expected to take (the
+  // last one's time, same pattern; double-double before its first run:
+  // 3.4x the double time, the measured upper end); 0 if unknown.
+  double PredictedSeconds(ProofPrecision precision) const;
+
   // Factorizations so far, by arithmetic, and the seconds spent in the
   // double-double ones (including their assembly and symbolic analysis).
   int double_factorizations() const { return double_factorizations_; }
@@ -100,6 +114,8 @@ class CertificateMatrix {
   void Assemble(const Eigen::MatrixXd& Lambda, double c, double mu,
                 std::vector<double>* rounding);
   bool ProveDouble(const Eigen::MatrixXd& Lambda, double c);
+  // factor_.factorize(K_), counted and timed.
+  void FactorizeDouble();
   bool ProveDoubleDouble(const Eigen::MatrixXd& Lambda, double c);
   // The permuted pattern and symbolic analysis of the double-double factor.
   void InitializeDoubleDouble();
@@ -124,6 +140,10 @@ class CertificateMatrix {
   double backward_error_ = 0;
   int double_factorizations_ = 0, extended_factorizations_ = 0;
   double extended_time_s_ = 0;
+  double last_double_seconds_ = 0, last_extended_seconds_ = 0;
+  std::chrono::steady_clock::time_point deadline_ =
+      std::chrono::steady_clock::time_point::max();
+  bool timed_out_ = false;
   // Double-double: the factorization, the map from K_'s value indices to its
   // permuted upper-triangle values, and those values.
   std::unique_ptr<DoubleDoubleCholesky> extended_;

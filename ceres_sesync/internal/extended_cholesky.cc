@@ -548,7 +548,8 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
 }
 
 bool DoubleDoubleCholesky::FactorizeSupernodal(
-    const std::vector<DoubleDouble>& values) {
+    const std::vector<DoubleDouble>& values,
+    std::chrono::steady_clock::time_point deadline) {
   const int num_super = num_supernodes();
   const Kernels kernels = vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2}
                                       : Kernels{UpdatePortable, ScalePortable};
@@ -568,7 +569,13 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   std::vector<int> pointer(num_super, 0), position(n_, -1);
   std::vector<int> relative;
   std::vector<double> work_hi, work_lo;
+  const bool has_deadline =
+      deadline != std::chrono::steady_clock::time_point::max();
   for (int s = 0; s < num_super; ++s) {
+    if (has_deadline && std::chrono::steady_clock::now() > deadline) {
+      timed_out_ = true;
+      return false;
+    }
     const int first = super_start_[s], last = super_start_[s + 1];
     const int ncols = last - first;
     const int nrows = super_row_start_[s + 1] - super_row_start_[s];
@@ -666,13 +673,16 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   return true;
 }
 
-bool DoubleDoubleCholesky::Factorize(const std::vector<DoubleDouble>& values) {
+bool DoubleDoubleCholesky::Factorize(
+    const std::vector<DoubleDouble>& values,
+    std::chrono::steady_clock::time_point deadline) {
   CHECK_EQ(values.size(), row_index_.size());
+  timed_out_ = false;
   for (const DoubleDouble& v : values) {
     if (!Safe(v)) return factorized_ = false;
   }
   if (options_.supernodal) {
-    factorized_ = FactorizeSupernodal(values);
+    factorized_ = FactorizeSupernodal(values, deadline);
     return factorized_;
   }
   std::vector<int> fill(n_);

@@ -41,6 +41,7 @@
 #ifndef CERES_SESYNC_INTERNAL_EXTENDED_CHOLESKY_H_
 #define CERES_SESYNC_INTERNAL_EXTENDED_CHOLESKY_H_
 
+#include <chrono>
 #include <vector>
 
 #include "ceres_sesync/internal/double_double.h"
@@ -70,7 +71,13 @@ class DoubleDoubleCholesky {
   // pattern. Returns false if a pivot is not positive (A is not positive
   // definite, up to the backward error) or if a value is so small that the
   // arithmetic could underflow (then nothing is proven).
-  bool Factorize(const std::vector<DoubleDouble>& values);
+  // With a `deadline`, the factorization stops (returns false, timed_out())
+  // when it passes, checked between supernodes.
+  bool Factorize(const std::vector<DoubleDouble>& values,
+                 std::chrono::steady_clock::time_point deadline =
+                     std::chrono::steady_clock::time_point::max());
+  // The last Factorize() stopped at its deadline.
+  bool timed_out() const { return timed_out_; }
 
   // After a successful Factorize(): rho_i >= sum_j |E_ij| for every row i
   // (permuted order), with the rounding of this computation itself covered.
@@ -106,7 +113,8 @@ class DoubleDoubleCholesky {
 
  private:
   void AnalyzeSupernodes();
-  bool FactorizeSupernodal(const std::vector<DoubleDouble>& values);
+  bool FactorizeSupernodal(const std::vector<DoubleDouble>& values,
+                           std::chrono::steady_clock::time_point deadline);
 
   Options options_;
   bool vectorized_ = false;
@@ -119,6 +127,7 @@ class DoubleDoubleCholesky {
   std::vector<int> row_count_;                 // Entries per row of L.
   double flops_ = 0;
   bool factorized_ = false;
+  bool timed_out_ = false;
   // Supernodes: columns super_start_[s] .. super_start_[s+1] - 1, rows
   // super_row_[super_row_start_[s] ..] (increasing, its columns first), values
   // (column-major, leading dimension = its row count) at

@@ -143,6 +143,12 @@ void Staircase::Progress(const char* stage, int rank, int iteration,
   options_.progress(p);
 }
 
+Staircase::Clock::time_point Staircase::Deadline() const {
+  if (options_.max_time_s <= 0) return Clock::time_point::max();
+  return start_ + std::chrono::duration_cast<Clock::duration>(
+                      std::chrono::duration<double>(options_.max_time_s));
+}
+
 double Staircase::RemainingTime() const {
   return options_.max_time_s > 0
              ? std::max(1e-3, options_.max_time_s - Elapsed())
@@ -286,6 +292,7 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
   verification_options.eta_goal =
       shift(options_.certification_goal_relative_bound);
   verification_options.policy = ToPolicy(options_.proof_arithmetic);
+  verification_options.deadline = Deadline();
   // The rounded poses cannot be proven closer to the optimum than their
   // rounding gap. When Algorithm 2 applied to Y now (an upper bound on the
   // final gap, before refinement) already misses the goal, the relaxation
@@ -384,6 +391,11 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
       s.status = SolverSummary::Status::kCertifiedOptimum;
       return;
     }
+    if (verification_.out_of_time) {
+      // Stopped at max_time_s: the best bound proven by then (if any) stands.
+      s.status = SolverSummary::Status::kTimeLimit;
+      return;
+    }
     if (verification_.eigensolver_failed) {
       // No negative curvature to climb along: either a bound was proven but
       // it is above the tolerance, or not even that.
@@ -455,6 +467,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
   o.eta_max = eta_max;
   o.eta_goal = eta_max / 4;
   o.policy = ProofPolicy::kDoubleDouble;
+  o.deadline = Deadline();
   const VerificationResult v =
       VerifyCertificate(*problem_, cost_->Lambda(), o, certificate_.get());
   s.factorizations += v.factorizations;

@@ -97,6 +97,8 @@ class Staircase {
                 double objective = 0, double gradient_norm = 0) const;
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
+  // start + max_time_s, or time_point::max() for no limit.
+  Clock::time_point Deadline() const;
   // One level's local optimization (RTR or Ceres LBFGS) from Y.
   void Optimize(int rank, Eigen::MatrixXd* Y, SolverSummary::Level* level);
   // The deferred double-double proof (see Report()).

@@ -147,9 +147,24 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     }
     return result;
   };
+  matrix->set_deadline(options.deadline);
+  const bool has_deadline =
+      options.deadline != std::chrono::steady_clock::time_point::max();
+  // Whether work predicted to take `seconds` fits before the deadline.
+  auto fits = [&](double seconds) {
+    if (!has_deadline) return true;
+    const double left = std::chrono::duration<double>(
+                            options.deadline - std::chrono::steady_clock::now())
+                            .count();
+    if (left > seconds && left > 0) return true;
+    result.out_of_time = true;
+    return false;
+  };
   double failed_double = 0;  // The largest shift a double proof failed at.
   auto prove = [&](double c, ProofPrecision precision) {
+    if (!fits(matrix->PredictedSeconds(precision))) return false;
     if (!matrix->Prove(Lambda, c, precision)) {
+      if (matrix->timed_out()) result.out_of_time = true;
       if (precision == ProofPrecision::kDouble) {
         failed_double = std::max(failed_double, c);
       }
@@ -196,9 +211,12 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
 
   // 2. Near-optimal (lambda_min(S) > -eta_max up to round-off) or not?
   bool near_optimal = result.eta <= eta_max;
-  if (!near_optimal && eta_max > eta_target) {
+  if (result.out_of_time) return finish();
+  if (!near_optimal && eta_max > eta_target &&
+      fits(matrix->PredictedSeconds(ProofPrecision::kDouble))) {
     near_optimal = matrix->Factorize(Lambda, eta_max);
   }
+  if (result.out_of_time) return finish();
   // 3. Near-optimal: tighten the proof.
   if (near_optimal) {
     if (use_extended) {
@@ -227,7 +245,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
         if (prove(c, ProofPrecision::kDouble) || c >= eta_max) break;
       }
     }
-    if (result.eta <= eta_max) return finish();
+    if (result.eta <= eta_max || result.out_of_time) return finish();
   }
 
   // 4. A witness of negative curvature. Bracket lambda_min(S) from below:
@@ -252,12 +270,15 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       factor_shift = c_vacuous;
     } else {
       result.vacuous_bound = true;
-      if (FindNegativeCurvature(problem, Lambda, &result)) return finish();
+      if (result.out_of_time) return finish();
+      if (fits(0) && FindNegativeCurvature(problem, Lambda, &result)) {
+        return finish();
+      }
       c = c_vacuous;
     }
   }
-  for (int step = 0; c < c_upper; ++step) {
-    if (step == 2 && matrix->supernodal() && !result.vacuous_bound) {
+  for (int step = 0; c < c_upper && !result.out_of_time; ++step) {
+    if (step == 2 && matrix->supernodal() && !result.vacuous_bound && fits(0)) {
       // lambda_min(S) < -256 max(eta_target, eta_max): usually clear
       // negative curvature (a saddle or a poor candidate), which Lanczos on
       // S finds in a few dozen products with Q; jump the shift just past
@@ -280,8 +301,8 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     }
   }
   if (!proven) return finish();  // Only round-off can make this fail.
-  if (result.eta <= eta_max) return finish();
-  if (result.direction.size() == 0) {
+  if (result.eta <= eta_max || result.out_of_time) return finish();
+  if (result.direction.size() == 0 && fits(0)) {
     // lambda_min(S_mu) > -c: the largest eigenvalue of (S_mu + cI)^{-1} is
     // 1 / (lambda_min + c). (Refactorize if the ladder failed after the
     // poor-candidate test proved c_vacuous.)

@@ -5,6 +5,8 @@
 #ifndef CERES_SESYNC_INTERNAL_VERIFICATION_H_
 #define CERES_SESYNC_INTERNAL_VERIFICATION_H_
 
+#include <chrono>
+
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 
@@ -32,6 +34,12 @@ struct VerificationOptions {
   // lambda_min(S) (the global-rotation directions, where S is near
   // singular): shifts below that are not tried in double.
   double translation_spread = 0;
+  // No factorization is started that is predicted to end after this
+  // (CertificateMatrix::PredictedSeconds), double-double ones stop at it,
+  // and nothing starts once it has passed; the result then has out_of_time
+  // and the best shift proven before.
+  std::chrono::steady_clock::time_point deadline =
+      std::chrono::steady_clock::time_point::max();
 };
 
 struct VerificationResult {
@@ -59,6 +67,8 @@ struct VerificationResult {
   int factorizations = 0;
   int extended_factorizations = 0;
   double extended_time_s = 0;
+  // The deadline stopped the verification early.
+  bool out_of_time = false;
 };
 
 // A lower bound, rounded down, on tr(Lambda) - eta d n (the dual objective
