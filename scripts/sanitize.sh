@@ -39,10 +39,11 @@ fi
 # installed (instrumented) static library: it needs the sanitizer runtimes at
 # link time, and its own code must be instrumented the same way (an
 # uninstrumented consumer freeing Eigen memory allocated in the instrumented
-# library is reported as a bad free). CMake initializes CMAKE_CXX_FLAGS and
+# library is reported as a bad free; it also needs the library's Eigen allocator
+# setting, see CMakeLists.txt). CMake initializes CMAKE_CXX_FLAGS and
 # CMAKE_EXE_LINKER_FLAGS from CXXFLAGS and LDFLAGS.
 export LDFLAGS="-fsanitize=address,undefined"
-export CXXFLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer"
+export CXXFLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -DEIGEN_MALLOC_ALREADY_ALIGNED=1"
 
 exclude=${CTEST_EXCLUDE-}
 cd "$build"
