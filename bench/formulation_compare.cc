@@ -210,7 +210,7 @@ double RegularizationShift(const SparseMatrix& D, double max_condition) {
 // (both triangles), and factorizes Mbar + eps E (E = I or diag(0, I_dn)).
 bool BuildExplicitData(const internal::SESyncProblem& problem, double eps,
                        bool shift_translations, ExplicitData* data) {
-  const int d = problem.dimension(), n = problem.num_poses(), t0 = n - 1;
+  const int d = problem.dimension(), n = problem.num_rotations(), t0 = n - 1;
   const int size = t0 + d * n;
   data->d = d;
   data->n = n;

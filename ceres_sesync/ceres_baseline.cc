@@ -312,9 +312,7 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
   };
   if (!blocks || !problem) return fail("null blocks or problem");
   std::string why;
-  ValidationOptions validation;
-  validation.allow_landmarks_and_priors = true;
-  if (!ValidatePoseGraph(graph, validation, &why))
+  if (!ValidatePoseGraph(graph, &why))
     return fail("invalid pose graph: " + why);
   const int d = graph.dimension;
   const int n = graph.num_poses;

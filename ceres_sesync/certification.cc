@@ -19,20 +19,53 @@ namespace ceres_sesync {
 bool Certify(const PoseGraph& graph, const Poses& candidate,
              const CertifyOptions& options, Certificate* certificate,
              std::string* error) {
+  if (graph.num_landmarks > 0) {
+    if (error) {
+      *error = "the graph has " + std::to_string(graph.num_landmarks) +
+               " landmarks: certify a Solution with their positions";
+    }
+    return false;
+  }
+  return Certify(graph, Solution{candidate, {}}, options, certificate, error);
+}
+
+bool Certify(const PoseGraph& graph, const Solution& candidate_solution,
+             const CertifyOptions& options, Certificate* certificate,
+             std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   auto fail = [&](const std::string& message) {
     if (error) *error = message;
     return false;
   };
   if (!ValidatePoseGraph(graph, error)) return false;
+  const Poses& candidate = candidate_solution.poses;
+  const LandmarkPositions& landmarks = candidate_solution.landmarks;
   const int d = graph.dimension, n = graph.num_poses;
   if (static_cast<int>(candidate.size()) != n) {
     return fail("candidate has " + std::to_string(candidate.size()) +
                 " poses, the graph has " + std::to_string(n));
   }
+  if (static_cast<int>(landmarks.size()) != graph.num_landmarks) {
+    return fail("candidate has " + std::to_string(landmarks.size()) +
+                " landmark positions, the graph has " +
+                std::to_string(graph.num_landmarks) + " landmarks");
+  }
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    if (landmarks[l].size() != d || !landmarks[l].allFinite()) {
+      return fail("candidate landmark " + std::to_string(l) + " (vertex " +
+                  std::to_string(graph.landmark_ids[l]) +
+                  ") is not a finite d-vector");
+    }
+  }
+  // The problem's rotation blocks: the poses, then R_w = I with priors
+  // (sesync_problem.h: the candidate in the world frame is the extended
+  // problem's point with w = (I, 0)).
+  const internal::ProblemLayout layout(graph);
+  const int n_rot = layout.num_rotations();
   Certificate c;
   Poses projected = candidate;
-  Eigen::MatrixXd R(d, d * n);
+  Eigen::MatrixXd R(d, d * n_rot);
+  R.rightCols(d * (n_rot - n)).setIdentity();
   for (int i = 0; i < n; ++i) {
     const Pose& p = candidate[i];
     if (p.R.rows() != d || p.R.cols() != d || p.t.size() != d) {
@@ -52,10 +85,11 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
   LOG_IF(WARNING, c.max_rotation_error > options.rotation_warning_tolerance)
       << "Certify: candidate rotations are up to " << c.max_rotation_error
       << " (Frobenius) away from SO(" << d << "); certifying their projection";
-  c.objective = EvaluateObjective(graph, projected);
+  c.objective = EvaluateObjective(graph, projected, landmarks);
   c.lambda_min = std::numeric_limits<double>::quiet_NaN();
 
-  if (n == 1) {  // No measurements: the single pose is trivially optimal.
+  if (n_rot == 1 && layout.num_translations() == 1) {
+    // A single pose, nothing else: trivially optimal.
     c.certified = true;
   } else {
     const internal::SESyncProblem problem(
@@ -69,14 +103,14 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
     // Largest eta for which the bound can still meet a relative bound b:
     // objective - (trace - eta d n) <= b (trace - eta d n).
     auto eta_for = [&](double b) {
-      return (b * trace - (c.objective - trace)) / (d * n * (1 + b));
+      return (b * trace - (c.objective - trace)) / (d * n_rot * (1 + b));
     };
     internal::VerificationOptions verification;
     verification.eta_max =
         std::max(eta_for(options.max_relative_suboptimality), 0.0);
     verification.eta_goal = eta_for(options.goal_relative_suboptimality);
     verification.eta_target =
-        std::max(options.target_relative_bound * std::abs(trace) / (d * n),
+        std::max(options.target_relative_bound * std::abs(trace) / (d * n_rot),
                  std::numeric_limits<double>::min());
     switch (options.proof_arithmetic) {
       case SolverOptions::ProofArithmetic::kAutomatic:
@@ -89,15 +123,22 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
         verification.policy = internal::ProofPolicy::kDoubleDouble;
         break;
     }
-    // The candidate's spread from pose 0 (see VerificationOptions).
+    // The candidate's spread from the gauge node (see VerificationOptions):
+    // pose 0, or the world origin t_w = 0.
+    const Eigen::VectorXd origin = layout.world_translation
+                                       ? Eigen::VectorXd::Zero(d)
+                                       : Eigen::VectorXd(projected[0].t);
     for (int a = 0; a < d; ++a) {
       double sum = 0;
       for (int i = 0; i < n; ++i) {
-        const double x = projected[i].t(a) - projected[0].t(a);
+        const double x = projected[i].t(a) - origin(a);
         sum += x * x;
       }
+      for (const Eigen::VectorXd& p : landmarks) {
+        sum += (p(a) - origin(a)) * (p(a) - origin(a));
+      }
       verification.translation_spread =
-          std::max(verification.translation_spread, sum / n);
+          std::max(verification.translation_spread, sum / n_rot);
     }
     internal::CertificateMatrix matrix(problem);
     const internal::VerificationResult v =
@@ -111,7 +152,7 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
       c.proof_precision = internal::ProofPrecisionName(v.precision);
       c.lower_bound = internal::ProvenLowerBound(Lambda, d, v.eta);
     }
-    if (!v.certified && v.direction.size() == d * n &&
+    if (!v.certified && v.direction.size() == d * n_rot &&
         v.direction_curvature < 0) {
       c.negative_curvature_direction = v.direction;
       c.negative_curvature = v.direction_curvature;
@@ -121,14 +162,12 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
   // F = 0 (up to round-off relative to the total weight) is optimal.
   if (!(c.lower_bound >= 0)) c.lower_bound = 0;
   c.lower_bound = std::min(c.lower_bound, c.objective);
-  double total_weight = 0;
-  for (const RelativePoseMeasurement& e : graph.measurements) {
-    total_weight += e.kappa + e.tau;
-  }
-  const bool zero_objective = c.objective <= 1e-12 * total_weight;
+  const bool zero_objective =
+      c.objective <= 1e-12 * internal::TotalPrecision(graph);
   // F(candidate) rounded up: the bound must not rest on round-off in F.
   c.suboptimality_bound =
-      internal::ObjectiveUpperBound(graph, projected) - c.lower_bound;
+      internal::ObjectiveUpperBound(graph, projected, landmarks) -
+      c.lower_bound;
   // A numerically zero F is optimal by F >= 0 (no ratio to a zero bound).
   c.relative_suboptimality_bound =
       zero_objective      ? 0
@@ -141,8 +180,11 @@ bool Certify(const PoseGraph& graph, const Poses& candidate,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
   if (!c.certified && options.improve_if_not_certified) {
-    c.improved_poses =
-        Solve(graph, projected, options.solver_options, &c.improvement_summary);
+    Solution improved;
+    Solve(graph, projected, options.solver_options, &improved,
+          &c.improvement_summary);
+    c.improved_poses = std::move(improved.poses);
+    c.improved_landmarks = std::move(improved.landmarks);
     c.has_improved_poses = !c.improved_poses.empty();
   }
   *certificate = std::move(c);

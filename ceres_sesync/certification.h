@@ -45,6 +45,15 @@
 // which certifies long trajectories and large maps to ~1e-7 and better.
 // Local minima from local search have lambda_min(S) many orders of magnitude
 // below these allowances, so they are never certified.
+//
+// Landmarks and priors (pose_graph.h): the candidate is a Solution (poses and
+// landmark positions, used as given, like translations). The landmarks are
+// eliminated with the translations (internal/sesync_problem.h), so Q and
+// Lambda stay matrices of rotation blocks; a graph with priors adds the
+// world pose w as one more block at R_w = I (the candidate is expressed in
+// the world frame), and the bound is that of the problem extended by w,
+// which has the same optimum (its objective is invariant under a global
+// rigid motion and equals F at w = (I, 0)). n below counts w.
 
 #ifndef CERES_SESYNC_CERTIFICATION_H_
 #define CERES_SESYNC_CERTIFICATION_H_
@@ -106,8 +115,9 @@ struct Certificate {
   int extended_factorizations = 0;
   double extended_proof_time_s = 0;
   // Proven lower bound on the optimal value: max(0, tr(Lambda) - eta d n)
-  // (F is a sum of squares). A candidate with F <= 1e-12 * sum(kappa + tau)
-  // (e.g. a tree, or noiseless data) is certified by F >= 0 alone.
+  // (F is a sum of squares). A candidate with F <= 1e-12 times the sum of
+  // all precisions (e.g. a tree, or noiseless data) is certified by F >= 0
+  // alone.
   double lower_bound = 0;
   // (objective - lower_bound) and its ratio to lower_bound, with the
   // objective rounded up by a bound on its own evaluation's round-off
@@ -117,14 +127,17 @@ struct Certificate {
   // Largest Frobenius distance of a candidate rotation from SO(d).
   double max_rotation_error = 0;
   // When lambda_min(S) is clearly negative: a unit vector v in R^{dn}
-  // (the d-blocks follow the graph's pose order) with v^T S v =
+  // (the d-blocks follow the graph's pose order, then R_w with priors) with
+  // v^T S v =
   // negative_curvature < 0, a witness that the candidate is not optimal for
   // the relaxation.
   Eigen::VectorXd negative_curvature_direction;
   double negative_curvature = 0;
-  // The improved solution (CertifyOptions::improve_if_not_certified).
+  // The improved solution (CertifyOptions::improve_if_not_certified): poses
+  // and landmark positions.
   bool has_improved_poses = false;
   Poses improved_poses;
+  LandmarkPositions improved_landmarks;
   SolverSummary improvement_summary;
   // Seconds spent (excluding the improvement run).
   double time_s = 0;
@@ -133,10 +146,16 @@ struct Certificate {
   std::string FullReport() const;
 };
 
-// Certifies `candidate` (one pose per graph pose) for `graph` (d = 2 or 3).
-// Returns false with a message in `error` for invalid input (graph fails
-// ValidatePoseGraph, wrong number of poses, wrong dimensions, non-finite
-// values); `certificate` is then not filled.
+// Certifies `candidate` (one pose per graph pose, one position per landmark)
+// for `graph` (d = 2 or 3). Returns false with a message in `error` for
+// invalid input (graph fails ValidatePoseGraph, wrong number of poses or
+// landmarks, wrong dimensions, non-finite values); `certificate` is then not
+// filled.
+bool Certify(const PoseGraph& graph, const Solution& candidate,
+             const CertifyOptions& options, Certificate* certificate,
+             std::string* error);
+// The same for a graph without landmarks (one with landmarks is an error:
+// their positions are part of the candidate).
 bool Certify(const PoseGraph& graph, const Poses& candidate,
              const CertifyOptions& options, Certificate* certificate,
              std::string* error);

@@ -1,63 +1,210 @@
 #include "ceres_sesync/chordal_initialization.h"
 
+#include <algorithm>
+#include <numeric>
+#include <vector>
+
 #include "ceres_sesync/internal/chordal.h"
 #include "ceres_sesync/internal/rounding.h"
 #include "ceres_sesync/internal/sesync_problem.h"
+#include "glog/logging.h"
 
 namespace ceres_sesync {
 
 namespace internal {
 
+namespace {
+
+int FindRoot(std::vector<int>& parent, int x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
+// Block-coordinate Procrustes over the component rotations G_c (see
+// ChordalRotations): G_c = Proj(M^T), M = -sum_{c' != c} A_cc' G_c'^T.
+std::vector<Eigen::MatrixXd> AlignComponents(const Eigen::MatrixXd& A, int d,
+                                             int k) {
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(d, d);
+  std::vector<Eigen::MatrixXd> G(k, I);
+  for (int sweep = 0; sweep < 50; ++sweep) {
+    double change = 0;
+    for (int c = 1; c < k; ++c) {
+      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d, d);
+      for (int e = 0; e < k; ++e) {
+        if (e != c) M -= A.block(d * c, d * e, d, d) * G[e].transpose();
+      }
+      const Eigen::MatrixXd next = ProjectToRotation(M.transpose());
+      change = std::max(change, (next - G[c]).norm());
+      G[c] = next;
+    }
+    if (k == 2 || change < 1e-12) break;  // k = 2: one exact step.
+  }
+  return G;
+}
+
+}  // namespace
+
 bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
-                                   Eigen::MatrixXd* R) {
-  const int dn = static_cast<int>(L.rows());
-  R->setIdentity(d, dn);
-  R->leftCols(d).setIdentity();
-  if (dn == d) return true;
-  // With R = [I, X]: minimize tr(X L11 X^T) + 2 tr(L01 X^T), i.e. solve
-  // L11 X^T = -L10 (L11 is positive definite for a connected graph).
-  const SparseMatrix L11 = L.bottomRightCorner(dn - d, dn - d);
-  const Eigen::MatrixXd L10 = L.bottomLeftCorner(dn - d, d);
+                                   Eigen::MatrixXd* R,
+                                   std::vector<int>* component) {
+  const int dn = static_cast<int>(L.rows()), n = dn / d;
+  // Components of the block graph: off-diagonal blocks with a nonzero entry.
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int k = 0; k < L.outerSize(); ++k) {
+    for (SparseMatrix::InnerIterator it(L, k); it; ++it) {
+      const int a = static_cast<int>(it.row()) / d,
+                b = static_cast<int>(it.col()) / d;
+      if (a != b && it.value() != 0) {
+        parent[FindRoot(parent, a)] = FindRoot(parent, b);
+      }
+    }
+  }
+  // Anchors: the first block of each component, fixed at I; the others
+  // ("free") are numbered in order.
+  std::vector<int> label(n, -1), root_label(n, -1), free_index(n, -1);
+  int num_components = 0, num_free = 0;
+  for (int i = 0; i < n; ++i) {
+    const int root = FindRoot(parent, i);
+    if (root_label[root] < 0) {
+      root_label[root] = num_components++;
+    } else {
+      free_index[i] = num_free++;
+    }
+    label[i] = root_label[root];
+  }
+  if (component) *component = label;
+  R->setZero(d, dn);
+  for (int i = 0; i < n; ++i) {
+    if (free_index[i] < 0) R->middleCols(d * i, d).setIdentity();
+  }
+  if (num_free == 0) return true;
+  // With R = [I .. I (anchors), X]: minimize tr(X L_ff X^T) + 2 tr(L_fa A
+  // X^T), i.e. solve L_ff X^T = -L_fa A (L_ff is positive definite when
+  // every component is connected through nonzero blocks).
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(L.nonZeros());
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(d * num_free, d);
+  for (int k = 0; k < L.outerSize(); ++k) {
+    for (SparseMatrix::InnerIterator it(L, k); it; ++it) {
+      const int r = static_cast<int>(it.row()), c = static_cast<int>(it.col());
+      const int fr = free_index[r / d], fc = free_index[c / d];
+      if (fr < 0) continue;
+      if (fc >= 0) {
+        triplets.emplace_back(d * fr + r % d, d * fc + c % d, it.value());
+      } else {
+        rhs(d * fr + r % d, c % d) -= it.value();
+      }
+    }
+  }
+  SparseMatrix L_ff(d * num_free, d * num_free);
+  L_ff.setFromTriplets(triplets.begin(), triplets.end());
   CholmodFactor factor;
   ConfigureCholmod(CholmodLayout::kSimplicial, &factor);
-  factor.compute(L11);
+  factor.compute(L_ff);
   if (factor.info() != Eigen::Success) return false;
-  const Eigen::MatrixXd Xt = factor.solve(-L10);
-  R->rightCols(dn - d) = ProjectBlocksToRotations(Xt.transpose(), d);
+  const Eigen::MatrixXd X =
+      ProjectBlocksToRotations(factor.solve(rhs).transpose(), d);
+  for (int i = 0; i < n; ++i) {
+    if (free_index[i] >= 0) {
+      R->middleCols(d * i, d) = X.middleCols(d * free_index[i], d);
+    }
+  }
+  return true;
+}
+
+bool ChordalRotations(const SESyncProblem& problem, Eigen::MatrixXd* R) {
+  const int d = problem.dimension(), n = problem.num_rotations();
+  std::vector<int> component;
+  if (!ChordalRotationsFromLaplacian(problem.RotationLaplacian(), d, R,
+                                     &component)) {
+    return false;
+  }
+  const int k = *std::max_element(component.begin(), component.end()) + 1;
+  if (k <= 1) return true;
+  constexpr int kMaxAlignedComponents = 64;
+  if (k > kMaxAlignedComponents) {
+    VLOG(1) << "chordal initialization: " << k
+            << " rotation components, not aligned";
+    return true;
+  }
+  // C: row block c holds the rotations of component c (zeros elsewhere).
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(d * k, d * n);
+  for (int i = 0; i < n; ++i) {
+    C.block(d * component[i], d * i, d, d) = R->middleCols(d * i, d);
+  }
+  Eigen::MatrixXd CQ;
+  problem.MultiplyQ(C, &CQ);
+  const Eigen::MatrixXd A = CQ * C.transpose();
+  const std::vector<Eigen::MatrixXd> G = AlignComponents(A, d, k);
+  for (int i = 0; i < n; ++i) {
+    R->middleCols(d * i, d) = G[component[i]] * R->middleCols(d * i, d);
+  }
   return true;
 }
 
 }  // namespace internal
 
-bool ChordalRotations(const PoseGraph& graph, Eigen::MatrixXd* R,
-                      std::string* error) {
+namespace {
+
+// Chordal rotations (d x dn, n rotation blocks) and the optimal translations
+// (d x N), in the frame of the world pose with priors, else with R_0 = I and
+// t_0 = 0.
+bool Chordal(const PoseGraph& graph, Solution* solution, std::string* error) {
   if (!ValidatePoseGraph(graph, error)) return false;
   const internal::SESyncProblem problem(graph);
-  if (!internal::ChordalRotationsFromLaplacian(problem.RotationLaplacian(),
-                                               graph.dimension, R)) {
+  Eigen::MatrixXd R;
+  if (!problem.ok() || !internal::ChordalRotations(problem, &R)) {
     if (error) *error = "chordal initialization: sparse Cholesky failed";
     return false;
+  }
+  const Eigen::MatrixXd T = problem.RecoverTranslations(R);
+  const internal::ProblemLayout& layout = problem.layout();
+  const int d = graph.dimension;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(d, d);
+  Eigen::VectorXd c = T.col(layout.gauge());
+  if (layout.world_rotation) {
+    A = R.middleCols(d * layout.world_rotation_block(), d).transpose();
+  }
+  solution->poses.resize(graph.num_poses);
+  for (int i = 0; i < graph.num_poses; ++i) {
+    const Eigen::MatrixXd Ri = R.middleCols(d * i, d);
+    solution->poses[i] =
+        Pose{layout.world_rotation ? internal::ProjectToRotation(A * Ri) : Ri,
+             A * (T.col(i) - c)};
+  }
+  solution->landmarks.resize(graph.num_landmarks);
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    solution->landmarks[l] = A * (T.col(layout.landmark_node(l)) - c);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool ChordalRotations(const PoseGraph& graph, Eigen::MatrixXd* R,
+                      std::string* error) {
+  Solution solution;
+  if (!Chordal(graph, &solution, error)) return false;
+  const int d = graph.dimension;
+  R->resize(d, d * graph.num_poses);
+  for (int i = 0; i < graph.num_poses; ++i) {
+    R->middleCols(d * i, d) = solution.poses[i].R;
   }
   return true;
 }
 
 bool ChordalInitialization(const PoseGraph& graph, Poses* poses,
                            std::string* error) {
-  if (!ValidatePoseGraph(graph, error)) return false;
-  const internal::SESyncProblem problem(graph);
-  Eigen::MatrixXd R;
-  if (!problem.ok() || !internal::ChordalRotationsFromLaplacian(
-                           problem.RotationLaplacian(), graph.dimension, &R)) {
-    if (error) *error = "chordal initialization: sparse Cholesky failed";
-    return false;
-  }
-  const Eigen::MatrixXd T = problem.RecoverTranslations(R);
-  const int d = graph.dimension;
-  poses->resize(graph.num_poses);
-  for (int i = 0; i < graph.num_poses; ++i) {
-    (*poses)[i] = Pose{R.middleCols(d * i, d), T.col(i)};
-  }
+  Solution solution;
+  if (!Chordal(graph, &solution, error)) return false;
+  *poses = std::move(solution.poses);
   return true;
+}
+
+bool ChordalInitialization(const PoseGraph& graph, Solution* solution,
+                           std::string* error) {
+  return Chordal(graph, solution, error);
 }
 
 }  // namespace ceres_sesync

@@ -17,12 +17,23 @@ namespace ceres_sesync {
 
 // Chordal rotations R = [R_1 ... R_n] (d x dn). `graph` must pass
 // ValidatePoseGraph. Returns false (with a message) if the sparse solve fails.
+// Gauge: R_0 = I; with priors, the world frame (the chordal estimate includes
+// the world rotation R_w, and R is expressed relative to it). Parts of the
+// graph whose rotations are tied together only through translations (the
+// world with position priors only; poses linked only by landmarks) are
+// estimated separately and then rotated into place against the full
+// objective (internal/chordal.h).
 bool ChordalRotations(const PoseGraph& graph, Eigen::MatrixXd* R,
                       std::string* error);
 
 // Chordal rotations plus the optimal translations for them, as poses with
-// pose 0 at the origin.
+// pose 0 at the origin (with priors: in the world frame, t_w = 0 when a
+// prior has a position term).
 bool ChordalInitialization(const PoseGraph& graph, Poses* poses,
+                           std::string* error);
+
+// The same with the optimal landmark positions (one per landmark).
+bool ChordalInitialization(const PoseGraph& graph, Solution* solution,
                            std::string* error);
 
 }  // namespace ceres_sesync

@@ -63,6 +63,15 @@ Poses SolveByComponent(const PoseGraph& graph, const SolverOptions& options,
     s.status = SolverSummary::Status::kInvalidInput;
     return {};
   }
+  if (graph.has_landmarks_or_priors()) {
+    // SplitIntoComponents carries poses and measurements only: refuse
+    // rather than drop the landmark and prior terms.
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message =
+        "solving by component does not support landmarks and priors; solve "
+        "a connected graph with them as a whole";
+    return {};
+  }
   std::vector<PoseGraphComponent> parts = SplitIntoComponents(graph);
   const int k = static_cast<int>(parts.size());
   Poses poses(graph.num_poses);

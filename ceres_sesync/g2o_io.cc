@@ -960,7 +960,6 @@ bool ParseG2oText(std::string_view text, const std::string& name,
 
   std::string invalid;
   ValidationOptions validation;
-  validation.allow_landmarks_and_priors = true;
   validation.require_connected = !options.allow_disconnected;
   if (!ValidatePoseGraph(*graph, validation, &invalid)) {
     if (error) *error = name + ": invalid pose graph: " + invalid;

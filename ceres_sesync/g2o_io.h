@@ -94,8 +94,7 @@
 // the translational terms must be connected too, see
 // TranslationalComponents in pose_graph.h), unless
 // G2oReadOptions::allow_disconnected is set. The result always passes
-// ValidatePoseGraph() with ValidationOptions::allow_landmarks_and_priors
-// (and require_connected = !allow_disconnected).
+// ValidatePoseGraph() (with require_connected = !allow_disconnected).
 //
 // Every writer replaces its output file atomically (temporary file + rename):
 // on failure no partial file is left behind.
@@ -120,8 +119,8 @@ struct G2oReadOptions {
   bool skip_unsupported_tags = false;
   // A disconnected measurement graph (including VERTEX lines without edges)
   // is an error by default. If true it is accepted; the result then passes
-  // ValidatePoseGraph with ValidationOptions::require_connected false and can be
-  // solved per connected component (component_solver.h).
+  // ValidatePoseGraph with ValidationOptions::require_connected false and can
+  // be solved per connected component (component_solver.h).
   bool allow_disconnected = false;
 };
 

@@ -261,16 +261,6 @@ bool ValidatePoseGraph(const PoseGraph& graph, const ValidationOptions& options,
       }
     }
   }
-  if (!options.allow_landmarks_and_priors && graph.has_landmarks_or_priors()) {
-    std::ostringstream s;
-    s << "the graph has " << L << " landmarks, "
-      << graph.landmark_measurements.size() << " landmark measurements and "
-      << graph.priors.size()
-      << " priors; Solve, Certify and the chordal initialization do not "
-         "support landmarks and priors yet (issue #15), only the Ceres "
-         "baseline (ceres_baseline.h) does";
-    return fail(s.str());
-  }
   return true;
 }
 

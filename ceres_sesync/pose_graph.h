@@ -161,13 +161,6 @@ int TranslationalComponents(const PoseGraph& graph,
                             std::vector<int>* component);
 
 struct ValidationOptions {
-  // TEMPORARY (issue #15): the solver core (Solve, Certify, the chordal
-  // initialization) does not handle landmarks and priors yet. The
-  // two-argument ValidatePoseGraph, which those call, uses false, so they
-  // fail with an explicit message (SolverSummary::Status::kInvalidInput in
-  // Solve) instead of silently ignoring the terms. The g2o reader and the
-  // Ceres baseline, which support them, validate with true.
-  bool allow_landmarks_and_priors = false;
   // A disconnected graph passes when false (each component is then a pose
   // graph of its own; see component_solver.h).
   bool require_connected = true;
@@ -188,8 +181,7 @@ struct ValidationOptions {
 // Returns false with a message otherwise.
 bool ValidatePoseGraph(const PoseGraph& graph, const ValidationOptions& options,
                        std::string* error);
-// The same with the default ValidationOptions: landmarks and priors are
-// rejected (see ValidationOptions::allow_landmarks_and_priors).
+// The same with the default ValidationOptions.
 bool ValidatePoseGraph(const PoseGraph& graph, std::string* error);
 
 // Evaluates the objective F(x, p) above (eq. (12) for a graph without

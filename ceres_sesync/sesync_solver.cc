@@ -9,8 +9,8 @@ namespace ceres_sesync {
 namespace {
 
 // problem -> initialize -> staircase -> round -> report (internal/staircase.h).
-Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
-                const SolverOptions& options, SolverSummary* summary) {
+Solution SolveImpl(const PoseGraph& graph, const Poses* initial,
+                   const SolverOptions& options, SolverSummary* summary) {
   internal::Staircase staircase(graph, options, summary);
   if (!staircase.ok()) return {};
   if (initial && static_cast<int>(initial->size()) != graph.num_poses) {
@@ -22,21 +22,32 @@ Poses SolveImpl(const PoseGraph& graph, const Poses* initial,
   Eigen::MatrixXd Y;
   if (!staircase.Initialize(initial, &Y)) return {};
   staircase.Run(&Y);
-  Poses poses = staircase.Round(Y);
-  staircase.Report(Y, poses);
-  return poses;
+  Solution solution = staircase.Round(Y);
+  staircase.Report(Y, solution);
+  return solution;
 }
 
 }  // namespace
 
 Poses Solve(const PoseGraph& graph, const SolverOptions& options,
             SolverSummary* summary) {
-  return SolveImpl(graph, nullptr, options, summary);
+  return SolveImpl(graph, nullptr, options, summary).poses;
 }
 
 Poses Solve(const PoseGraph& graph, const Poses& initial,
             const SolverOptions& options, SolverSummary* summary) {
-  return SolveImpl(graph, &initial, options, summary);
+  return SolveImpl(graph, &initial, options, summary).poses;
+}
+
+void Solve(const PoseGraph& graph, const SolverOptions& options,
+           Solution* solution, SolverSummary* summary) {
+  *solution = SolveImpl(graph, nullptr, options, summary);
+}
+
+void Solve(const PoseGraph& graph, const Poses& initial,
+           const SolverOptions& options, Solution* solution,
+           SolverSummary* summary) {
+  *solution = SolveImpl(graph, &initial, options, summary);
 }
 
 std::string SolverSummary::StatusString() const {
@@ -88,6 +99,11 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %d\n", "Dimension", dimension);
   line("%-34s %d\n", "Poses", num_poses);
   line("%-34s %d\n", "Measurements", num_measurements);
+  if (num_landmarks > 0 || num_priors > 0) {
+    line("%-34s %d\n", "Landmarks", num_landmarks);
+    line("%-34s %d\n", "Landmark measurements", num_landmark_measurements);
+    line("%-34s %d\n", "Priors", num_priors);
+  }
   if (status == Status::kInvalidInput) {
     line("%-34s %s\n", "Error", message.c_str());
     return out;

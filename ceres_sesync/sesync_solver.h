@@ -207,15 +207,19 @@ struct SolverSummary {
   // kBoundAboveTolerance.
   std::string message;
   int dimension = 0, num_poses = 0, num_measurements = 0;
-  // F(x) of eq. (12) at the returned poses.
+  // Landmarks, landmark measurements and priors of the graph.
+  int num_landmarks = 0, num_landmark_measurements = 0, num_priors = 0;
+  // F(x) (pose_graph.h: eq. (12) plus the landmark and prior terms) at the
+  // returned solution.
   double objective = 0;
   // F(Y) = tr(Q Y^T Y) at the final factor Y (the SDP relaxation's value
   // there).
   double sdp_value = 0;
   // Proven lower bound on the optimal value: max(0, tr(Lambda) - eta d n),
-  // rounded down (F is a sum of squares, so 0 is always one). Poses with F(x)
-  // <= 1e-12 sum(kappa + tau) (trees, noiseless data) are certified by F >= 0
-  // alone.
+  // rounded down (F is a sum of squares, so 0 is always one; n counts the
+  // world pose when the graph has priors). Solutions with F(x) <= 1e-12 times
+  // the sum of all precisions (trees, noiseless data) are certified by
+  // F >= 0 alone.
   double lower_bound = 0;
   // (objective - lower_bound) and its ratio to lower_bound, with the
   // objective rounded up by a bound on its own evaluation's round-off
@@ -256,14 +260,31 @@ struct SolverSummary {
   std::string FullReport() const;
 };
 
-// Solves the pose graph; the initialization comes from options.
+// Solves the pose graph; the initialization comes from options. Returns the
+// poses (empty on invalid input); for a graph with landmarks, the overloads
+// with a Solution also return the landmark positions.
 Poses Solve(const PoseGraph& graph, const SolverOptions& options,
             SolverSummary* summary);
 
 // Solves the pose graph starting from the given poses (their rotations are
-// projected to SO(d)); options.initialization is ignored.
+// projected to SO(d); the translations are not used: they are optimal for the
+// rotations at every step); options.initialization is ignored.
 Poses Solve(const PoseGraph& graph, const Poses& initial,
             const SolverOptions& options, SolverSummary* summary);
+
+// The same for graphs with landmarks and priors (and any other graph):
+// *solution gets the poses and one position per landmark (dense landmark
+// order), both empty on invalid input. Landmarks, like translations, are
+// eliminated in closed form (sesync_problem.h), so only the initial poses'
+// rotations matter. Gauge: with priors the solution is in the world frame
+// of the priors (they fix the gauge; no FIX pose); without priors as for
+// pose graphs (the FIX pose, else pose 0, at its initial value, else at
+// the identity), landmarks moved with the poses.
+void Solve(const PoseGraph& graph, const SolverOptions& options,
+           Solution* solution, SolverSummary* summary);
+void Solve(const PoseGraph& graph, const Poses& initial,
+           const SolverOptions& options, Solution* solution,
+           SolverSummary* summary);
 
 }  // namespace ceres_sesync
 

@@ -412,9 +412,7 @@ TEST(LandmarkInitialization, IslandsTiedByPriorsAreEachPlaced) {
     g.priors.push_back({i, truth.poses[i].R, truth.poses[i].t, 5.0, 5.0});
   }
   std::string error;
-  ValidationOptions validation;
-  validation.allow_landmarks_and_priors = true;
-  ASSERT_TRUE(ValidatePoseGraph(g, validation, &error)) << error;
+  ASSERT_TRUE(ValidatePoseGraph(g, &error)) << error;
   const Poses poses = OdometryInitialization(g);
   EXPECT_LT(WorldFrameDistance(Solution{poses, {}}, truth), 1e-12);
 }

@@ -8,7 +8,10 @@
 // (every rotation turned by a random angle), and (c) a random point of
 // St(d, d + 2)^n. The central property is SOUNDNESS: a successful
 // factorization must never happen when S + cI is clearly indefinite, and a
-// certified result must really have lambda_min(S) >= -eta.
+// certified result must really have lambda_min(S) >= -eta. The graphs
+// include landmarks and priors (dense S from the Schur complement of
+// tests/util's DenseLandmarkDataMatrix; the proofs assemble K from the
+// landmark and prior terms through the same paths as the edges).
 
 #include "ceres_sesync/internal/certificate_matrix.h"
 
@@ -52,15 +55,25 @@ struct Instance {
   double f = 0;      // F at the point Lambda came from.
 };
 
+// A test graph; `dense` marks the one meant to get a supernodal factor.
+struct GraphCase {
+  std::string name;
+  PoseGraph graph;
+  bool dense = false;
+};
+
 class CertificateTest : public ::testing::Test {
  protected:
-  // Builds the three kinds of multipliers for one random graph.
-  void Build(const RandomGraphOptions& o) {
-    graph_ = test_util::RandomPoseGraph(o, nullptr);
+  // Builds the three kinds of multipliers for one graph.
+  void Build(const GraphCase& c) {
+    graph_ = c.graph;
     problem_ = std::make_unique<SESyncProblem>(graph_);
     ASSERT_TRUE(problem_->ok());
-    Q_ = test_util::DenseQ(graph_);
-    const int d = o.dimension, n = o.num_poses;
+    Q_ = graph_.has_landmarks_or_priors() ? test_util::DenseLandmarkQ(graph_)
+                                          : test_util::DenseQ(graph_);
+    const int d = graph_.dimension, n = problem_->num_rotations();
+    ASSERT_EQ(Q_.rows(), d * n);
+    const uint64_t seed = 1000 + graph_.num_poses + graph_.num_landmarks;
     SESyncPreconditioner none(*problem_, PreconditionerType::kNone, 1e6);
     SESyncCost cost(problem_.get(), &none);
     auto add = [&](const std::string& name, const MatrixXd& Y) {
@@ -79,9 +92,10 @@ class CertificateTest : public ::testing::Test {
     SolverSummary summary;
     const Poses x = Solve(graph_, SolverOptions(), &summary);
     ASSERT_TRUE(summary.certified()) << summary.FullReport();
-    const MatrixXd R = test_util::StackRotations(x);
+    // In the world frame with priors: R_w = I.
+    const MatrixXd R = test_util::StackSolverRotations(graph_, x);
     add("optimum", R);
-    std::mt19937_64 rng(o.seed + 1000);
+    std::mt19937_64 rng(seed);
     MatrixXd perturbed = R;
     std::normal_distribution<double> normal;
     for (int i = 0; i < n; ++i) {
@@ -107,8 +121,8 @@ class CertificateTest : public ::testing::Test {
   std::vector<Instance> instances_;
 };
 
-std::vector<RandomGraphOptions> Graphs() {
-  std::vector<RandomGraphOptions> graphs;
+std::vector<GraphCase> Graphs() {
+  std::vector<GraphCase> graphs;
   uint64_t seed = 40;
   for (int d : {2, 3}) {
     for (int n : {10, 60}) {
@@ -119,7 +133,9 @@ std::vector<RandomGraphOptions> Graphs() {
       o.kappa = 50;
       o.tau = 20;
       o.seed = seed++;
-      graphs.push_back(o);
+      graphs.push_back(
+          {"random d " + std::to_string(d) + " n " + std::to_string(n),
+           test_util::RandomPoseGraph(o, nullptr)});
     }
   }
   // A long chain (poorly conditioned translational Laplacian: the coupling
@@ -132,7 +148,7 @@ std::vector<RandomGraphOptions> Graphs() {
   chain.kappa = 50;
   chain.tau = 20;
   chain.seed = 77;
-  graphs.push_back(chain);
+  graphs.push_back({"chain", test_util::RandomPoseGraph(chain, nullptr)});
   // Dense loop closures: CHOLMOD picks a supernodal factor, and verification
   // takes the Lanczos-on-S path for clearly negative curvature.
   RandomGraphOptions dense;
@@ -142,14 +158,39 @@ std::vector<RandomGraphOptions> Graphs() {
   dense.kappa = 50;
   dense.tau = 20;
   dense.seed = 78;
-  graphs.push_back(dense);
+  graphs.push_back(
+      {"dense", test_util::RandomPoseGraph(dense, nullptr), /*dense=*/true});
+  // Landmarks (the eliminated translations grow) with and without priors
+  // (the world block R_w, and t_w as the gauge node), 2D and 3D; sparse
+  // odometry so that the landmarks carry much of the structure.
+  for (int d : {2, 3}) {
+    for (int priors : {0, 1}) {
+      test_util::RandomLandmarkGraphOptions l;
+      l.poses.dimension = d;
+      l.poses.num_poses = 40;
+      l.poses.num_loop_closures = 4;
+      l.poses.kappa = 50;
+      l.poses.tau = 20;
+      l.poses.seed = seed++;
+      l.num_landmarks = 60;
+      l.observations_per_landmark = 3;
+      l.nu = 10;
+      l.num_position_priors = 3 * priors;
+      l.num_rotation_priors = priors;
+      l.num_pose_priors = priors;
+      graphs.push_back(
+          {"landmarks d " + std::to_string(d) + (priors ? " priors" : ""),
+           test_util::RandomLandmarkGraph(l, nullptr)});
+    }
+  }
   return graphs;
 }
 
 // MultiplyCertificate(v) = S v.
 TEST_F(CertificateTest, MultiplyCertificateMatchesDense) {
   std::mt19937_64 rng(3);
-  for (const RandomGraphOptions& o : Graphs()) {
+  for (const GraphCase& o : Graphs()) {
+    SCOPED_TRACE(o.name);
     instances_.clear();
     Build(o);
     for (const Instance& in : instances_) {
@@ -170,11 +211,13 @@ TEST_F(CertificateTest, MultiplyCertificateMatchesDense) {
 // guarantee); double-double proofs succeed as soon as lambda_min(S + cI) is
 // above ~1e-25 ||S||, double proofs once it covers their round-off.
 TEST_F(CertificateTest, ProofsAgreeWithDenseEigenvalues) {
-  for (const RandomGraphOptions& o : Graphs()) {
+  for (const GraphCase& o : Graphs()) {
+    SCOPED_TRACE(o.name);
     instances_.clear();
     Build(o);
     CertificateMatrix matrix(*problem_);
-    EXPECT_EQ(matrix.dimension(), o.dimension * o.num_poses);
+    EXPECT_EQ(matrix.dimension(),
+              o.graph.dimension * problem_->num_rotations());
     for (const Instance& in : instances_) {
       const double lmin = in.lambda_min, s = in.scale;
       struct Shift {
@@ -195,8 +238,8 @@ TEST_F(CertificateTest, ProofsAgreeWithDenseEigenvalues) {
         shifts.push_back({-0.9 * lmin, false});
       }
       for (const Shift& sh : shifts) {
-        SCOPED_TRACE(in.name + ": d " + std::to_string(o.dimension) + " n " +
-                     std::to_string(o.num_poses) + " lambda_min(S) " +
+        SCOPED_TRACE(in.name + ": d " + std::to_string(in.d) + " n " +
+                     std::to_string(in.n) + " lambda_min(S) " +
                      std::to_string(lmin) + " c " + std::to_string(sh.c));
         EXPECT_EQ(matrix.Factorize(in.Lambda, sh.c), sh.positive_definite);
         for (auto precision : {internal::ProofPrecision::kDouble,
@@ -228,7 +271,8 @@ TEST_F(CertificateTest, ProofsAgreeWithDenseEigenvalues) {
 // 1e-11 ||S|| (the solver's eta is ~1e-9 F / (d n)). A successful proof at c
 // would be a false certificate unless proven_shift() covers the gap.
 TEST_F(CertificateTest, NoFalseCertificateAtSmallShifts) {
-  for (const RandomGraphOptions& o : Graphs()) {
+  for (const GraphCase& o : Graphs()) {
+    SCOPED_TRACE(o.name);
     instances_.clear();
     Build(o);
     CertificateMatrix matrix(*problem_);
@@ -262,13 +306,16 @@ TEST_F(CertificateTest, NoFalseCertificateAtSmallShifts) {
 // (S + cI)^{-1} y by the sparse factor equals the dense solve.
 TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
   std::mt19937_64 rng(5);
-  for (const RandomGraphOptions& o : Graphs()) {
+  for (const GraphCase& o : Graphs()) {
+    SCOPED_TRACE(o.name);
     instances_.clear();
     Build(o);
-    const MatrixXd M = test_util::DenseDataMatrix(graph_);
+    // Lbar, Vbar and D in the solver's index sets (gauge node dropped).
+    const test_util::DenseLandmarkProblem blocks =
+        test_util::BuildDenseLandmarkProblem(graph_);
     for (bool proof : {false, true}) {
       CertificateMatrix matrix(*problem_);
-      if (o.num_loop_closures >= 10 * o.num_poses) {
+      if (o.dense) {
         EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
       }
       for (const Instance& in : instances_) {
@@ -282,12 +329,10 @@ TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
         // Schur complement S_mu + cI, computed densely here.
         const double mu = matrix.translation_shift();
         EXPECT_EQ(mu > 0, proof);
-        const int n1 = in.n - 1;
-        const MatrixXd Lbar =
-            M.block(1, 1, n1, n1) - mu * MatrixXd::Identity(n1, n1);
-        const MatrixXd V = M.block(1, in.n, n1, dn);
-        const MatrixXd S_mu = M.bottomRightCorner(dn, dn) -
-                              V.transpose() * Lbar.llt().solve(V) -
+        const int n1 = static_cast<int>(blocks.Lbar.rows());
+        const MatrixXd Lbar = blocks.Lbar - mu * MatrixXd::Identity(n1, n1);
+        const MatrixXd& V = blocks.Vbar;
+        const MatrixXd S_mu = blocks.D - V.transpose() * Lbar.llt().solve(V) -
                               test_util::BlockDiagonalToDense(in.Lambda, in.d);
         const MatrixXd shifted = S_mu + c * MatrixXd::Identity(dn, dn);
         // S_mu <= S, and for mu at round-off level nearly equal.
@@ -311,14 +356,15 @@ TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
 // (eta ~ 1e-9 F / (d n) target, 1e-6 F / (d n) max) and with a loose eta_max.
 TEST_F(CertificateTest, VerifyCertificateAgreesWithDenseSpectrum) {
   int vacuous = 0;
-  for (const RandomGraphOptions& o : Graphs()) {
+  for (const GraphCase& o : Graphs()) {
+    SCOPED_TRACE(o.name);
     instances_.clear();
     Build(o);
     for (auto policy :
          {internal::ProofPolicy::kAutomatic, internal::ProofPolicy::kDouble,
           internal::ProofPolicy::kDoubleDouble}) {
       CertificateMatrix matrix(*problem_);
-      if (o.num_loop_closures >= 10 * o.num_poses) {
+      if (o.dense) {
         EXPECT_TRUE(matrix.supernodal());  // The case meant to exercise it.
       }
       for (const Instance& in : instances_) {

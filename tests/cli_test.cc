@@ -1,6 +1,6 @@
 // Tests of the `ceres_sesync` program's command line (run as a separate
-// process, as a user would): help, flag checking, progress output, and
-// `solve --components`.
+// process, as a user would): help, flag checking, progress output,
+// `solve --components`, and landmarks and priors through solve and certify.
 
 #include <cmath>
 #include <filesystem>
@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/pose_graph.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/util/json_validator.h"
@@ -167,6 +169,113 @@ TEST_F(CliTest, SolveComponents) {
     EXPECT_THAT(written, HasSubstr(std::string("VERTEX_SE2 ") + id));
   }
   for (const std::string& path : {graph, json_path, poses}) fs::remove(path);
+}
+
+// Three 2D poses (ids 10, 20, 30 at (0, 0, 0), (1, 0, pi/2), (1, 1, pi)),
+// landmarks with ids out of order and below the pose ids (100 at (2, 0.5),
+// 7 at (0.5, 1.5), 55 at (-0.5, 0.5)), exact measurements, and a full pose
+// prior on vertex 10 at the identity: the optimum is exactly that map, in
+// the world frame of the prior.
+const char kLandmarks2d[] =
+    "VERTEX_XY 100 0 0\n"
+    "VERTEX_XY 7 0 0\n"
+    "VERTEX_XY 55 0 0\n"
+    "EDGE_SE2 10 20 1 0 1.5707963267948966 1 0 0 1 0 1\n"
+    "EDGE_SE2 20 30 1 0 1.5707963267948966 1 0 0 1 0 1\n"
+    "EDGE_SE2_XY 10 100 2 0.5 4 0 4\n"
+    "EDGE_SE2_XY 10 55 -0.5 0.5 4 0 4\n"
+    "EDGE_SE2_XY 20 100 0.5 -1 4 0 4\n"
+    "EDGE_SE2_XY 20 7 1.5 0.5 4 0 4\n"
+    "EDGE_SE2_XY 30 7 0.5 -0.5 4 0 4\n"
+    "EDGE_SE2_XY 30 55 1.5 0.5 4 0 4\n"
+    "EDGE_PRIOR_SE2 10 0 0 0 10 0 0 10 0 10\n";
+
+TEST_F(CliTest, LandmarksAndPriorsThroughSolveAndCertify) {
+  const std::string graph_path = TempPath("landmarks.g2o");
+  const std::string solved = TempPath("landmarks_solved.g2o");
+  const std::string json_path = TempPath("landmarks.json");
+  const std::string certify_json = TempPath("landmarks_certify.json");
+  WriteText(graph_path, kLandmarks2d);
+  RunResult run = RunToolWithOutput("solve " + graph_path + " --output " +
+                                    solved + " --json " + json_path);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.out, HasSubstr("Landmarks                          3"));
+  EXPECT_THAT(run.out, HasSubstr("Priors                             1"));
+  const std::string json = ReadText(json_path);
+  ASSERT_TRUE(IsValidJson(json)) << json;
+  EXPECT_THAT(json, HasSubstr("\"num_landmarks\": 3"));
+  EXPECT_THAT(json, HasSubstr("\"num_landmark_measurements\": 6"));
+  EXPECT_THAT(json, HasSubstr("\"num_priors\": 1"));
+  EXPECT_THAT(json, HasSubstr("\"certified\": true"));
+  // The written solution: every pose and landmark with its original id, at
+  // the exact map in the world frame.
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(ReadG2oFile(graph_path, {}, &graph, &error)) << error;
+  Solution x;
+  ASSERT_TRUE(ReadG2oSolution(solved, graph, &x, &error)) << error;
+  const std::string written = ReadText(solved);
+  for (const char* line : {"VERTEX_SE2 10 ", "VERTEX_SE2 20 ", "VERTEX_SE2 30 ",
+                           "VERTEX_XY 100 ", "VERTEX_XY 7 ", "VERTEX_XY 55 "}) {
+    EXPECT_THAT(written, HasSubstr(line));
+  }
+  auto landmark = [&](int64_t id) {
+    return x.landmarks[graph.FindLandmark(id)];
+  };
+  EXPECT_LT((landmark(100) - Eigen::Vector2d(2, 0.5)).norm(), 1e-9);
+  EXPECT_LT((landmark(7) - Eigen::Vector2d(0.5, 1.5)).norm(), 1e-9);
+  EXPECT_LT((landmark(55) - Eigen::Vector2d(-0.5, 0.5)).norm(), 1e-9);
+  const Pose& p30 = x.poses[graph.FindVertex(30)];
+  EXPECT_LT((p30.t - Eigen::Vector2d(1, 1)).norm(), 1e-9);
+  EXPECT_LT((p30.R + Eigen::Matrix2d::Identity()).norm(), 1e-9);
+  EXPECT_NEAR(JsonNumber(json, "\"graph\"", "objective"),
+              EvaluateObjective(graph, x), 1e-12);
+
+  // certify reads the landmarks back: certified, the same objective.
+  run = RunToolWithOutput("certify " + graph_path + " " + solved + " --json " +
+                          certify_json);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  const std::string cjson = ReadText(certify_json);
+  EXPECT_THAT(cjson, HasSubstr("\"certified\": true"));
+  EXPECT_THAT(cjson, HasSubstr("\"num_landmarks\": 3"));
+  EXPECT_NEAR(JsonNumber(cjson, "\"graph\"", "objective"),
+              EvaluateObjective(graph, x), 1e-12);
+  fs::remove(certify_json);
+
+  // A candidate without one landmark's line: an input error naming it.
+  std::string partial;
+  for (size_t at = 0; at < written.size();) {
+    const size_t end = written.find('\n', at);
+    const std::string line = written.substr(at, end - at + 1);
+    if (line.rfind("VERTEX_XY 55 ", 0) != 0) partial += line;
+    at = end + 1;
+  }
+  const std::string partial_path = TempPath("landmarks_partial.g2o");
+  WriteText(partial_path, partial);
+  run = RunToolWithOutput("certify " + graph_path + " " + partial_path +
+                          " --json " + certify_json);
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.err, HasSubstr("55"));
+  EXPECT_FALSE(fs::exists(certify_json));
+
+  // --components does not split landmarks and priors: refused, no output.
+  fs::remove(solved);
+  run = RunToolWithOutput("solve " + graph_path + " --components --output " +
+                          solved);
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.err, HasSubstr("landmarks and priors"));
+  EXPECT_FALSE(fs::exists(solved));
+
+  // A bad landmark line: the file and line, exit 2, nothing written.
+  WriteText(graph_path,
+            std::string(kLandmarks2d) + "EDGE_SE2_XY 30 100 nan 0.5 4 0 4\n");
+  run = RunToolWithOutput("solve " + graph_path + " --output " + solved);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr(graph_path + ":13:"));
+  EXPECT_FALSE(fs::exists(solved));
+  for (const std::string& path : {graph_path, json_path, partial_path}) {
+    fs::remove(path);
+  }
 }
 
 TEST_F(CliTest, ProgressOnlyWhenAskedForOnAPipe) {

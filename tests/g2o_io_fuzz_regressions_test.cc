@@ -122,9 +122,7 @@ TEST(G2oFuzzRegressions, RecordedOutcomesAndInvariants) {
       continue;
     }
     std::string invalid;
-    ValidationOptions validation;
-    validation.allow_landmarks_and_priors = true;
-    EXPECT_TRUE(ValidatePoseGraph(g, validation, &invalid)) << invalid;
+    EXPECT_TRUE(ValidatePoseGraph(g, &invalid)) << invalid;
     EXPECT_EQ(summary.num_vertices, g.num_poses);
     EXPECT_EQ(summary.num_landmarks, g.num_landmarks);
     EXPECT_EQ(summary.num_landmark_edges,

@@ -42,12 +42,6 @@ PoseGraph Generate(const LandmarkGraphOptions& o, Solution* truth) {
   return graph;
 }
 
-ValidationOptions AllowLandmarks() {
-  ValidationOptions v;
-  v.allow_landmarks_and_priors = true;
-  return v;
-}
-
 TEST(LandmarkGenerator, WalkFollowsTheManhattanRules) {
   for (int d : {2, 3}) {
     SCOPED_TRACE(d);
@@ -102,7 +96,7 @@ TEST(LandmarkGenerator, ObservationsFollowTheSensorModel) {
     Solution truth;
     const PoseGraph g = Generate(o, &truth);
     std::string error;
-    ASSERT_TRUE(ValidatePoseGraph(g, AllowLandmarks(), &error)) << error;
+    ASSERT_TRUE(ValidatePoseGraph(g, ValidationOptions(), &error)) << error;
     ASSERT_GT(g.num_landmarks, 10);
     EXPECT_LE(g.num_landmarks, o.num_landmarks);
     ASSERT_EQ(static_cast<int>(truth.landmarks.size()), g.num_landmarks);
@@ -177,7 +171,7 @@ TEST(LandmarkGenerator, PriorsAndDeterminism) {
     EXPECT_EQ(g.priors[k].tau, o.gps_tau);
   }
   std::string error;
-  EXPECT_TRUE(ValidatePoseGraph(g, AllowLandmarks(), &error)) << error;
+  EXPECT_TRUE(ValidatePoseGraph(g, ValidationOptions(), &error)) << error;
   // Same options, same graph; another seed, another graph.
   Solution again_truth;
   const PoseGraph again = Generate(o, &again_truth);
@@ -225,7 +219,7 @@ TEST(LandmarkGenerator, VictoriaParkLikePresetSeesManyLandmarksPerPose) {
       static_cast<double>(g.landmark_measurements.size()) / g.num_poses;
   EXPECT_GT(per_pose, 15) << per_pose;
   std::string error;
-  EXPECT_TRUE(ValidatePoseGraph(g, AllowLandmarks(), &error)) << error;
+  EXPECT_TRUE(ValidatePoseGraph(g, ValidationOptions(), &error)) << error;
 }
 
 TEST(LandmarkGenerator, RejectsInvalidOptions) {
@@ -396,20 +390,19 @@ TEST(GenerateLandmarksCommand, WritesTheGraphAndTheGroundTruth) {
     const double f = EvaluateObjective(expected, truth);
     EXPECT_NEAR(EvaluateObjective(graph, file_truth), f, 1e-9 * f);
   }
-  // For now (issue #15) solve and certify refuse such graphs explicitly,
-  // exit 2, and write nothing.
+  // The generated graph (the last one, 3D) solves and certifies with the
+  // program; its solution file reads back with every landmark.
   const std::string solved = dir + "/landmark_generator_test_solved.g2o";
   std::remove(solved.c_str());
-  const std::string log = dir + "/landmark_generator_test_solve.log";
-  EXPECT_EQ(RunTool("solve " + output + " --output " + solved, log), 2);
-  std::string message;
-  ASSERT_TRUE(internal::ReadFileToString(log, &message, nullptr));
-  EXPECT_NE(message.find("do not support landmarks and priors yet"),
-            std::string::npos)
-      << message;
-  EXPECT_FALSE(Exists(solved));
-  EXPECT_EQ(RunTool("certify " + output + " " + truth_path), 2);
-  std::remove(log.c_str());
+  EXPECT_EQ(RunTool("solve " + output + " --output " + solved), 0);
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(ReadG2oFile(output, {}, &graph, &error)) << error;
+  Solution solution;
+  ASSERT_TRUE(ReadG2oSolution(solved, graph, &solution, &error)) << error;
+  EXPECT_EQ(static_cast<int>(solution.landmarks.size()), graph.num_landmarks);
+  EXPECT_EQ(RunTool("certify " + output + " " + solved), 0);
+  std::remove(solved.c_str());
 
   std::remove(output.c_str());
   EXPECT_EQ(RunTool("generate landmarks"), 2);  // No --output.

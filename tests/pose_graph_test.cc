@@ -39,12 +39,6 @@ TEST(PoseGraphTest, ConnectedComponentsCountsIslands) {
 // ---- landmarks and priors
 // ----------------------------------------------------
 
-ValidationOptions AllowLandmarks() {
-  ValidationOptions options;
-  options.allow_landmarks_and_priors = true;
-  return options;
-}
-
 PoseGraph LandmarkGraph(int d, uint64_t seed, Solution* truth,
                         bool noiseless = false) {
   test_util::RandomLandmarkGraphOptions options;
@@ -71,7 +65,7 @@ TEST(LandmarkObjectiveTest, EqualsTheDenseQuadraticForm) {
       Solution truth;
       const PoseGraph g = LandmarkGraph(d, seed, &truth);
       std::string error;
-      ASSERT_TRUE(ValidatePoseGraph(g, AllowLandmarks(), &error)) << error;
+      ASSERT_TRUE(ValidatePoseGraph(g, ValidationOptions(), &error)) << error;
       const Eigen::MatrixXd M = test_util::DenseLandmarkDataMatrix(g);
       std::mt19937_64 rng(seed);
       Solution random{test_util::RandomPoses(d, g.num_poses, 5, &rng), {}};
@@ -135,7 +129,7 @@ TEST(LandmarkValidationTest, AcceptsValidGraphsAndNamesEachProblem) {
   Solution truth;
   const PoseGraph good = LandmarkGraph(2, 5, &truth);
   std::string error;
-  ASSERT_TRUE(ValidatePoseGraph(good, AllowLandmarks(), &error)) << error;
+  ASSERT_TRUE(ValidatePoseGraph(good, ValidationOptions(), &error)) << error;
   const struct {
     const char* name;
     void (*mutate)(PoseGraph*);
@@ -185,7 +179,7 @@ TEST(LandmarkValidationTest, AcceptsValidGraphsAndNamesEachProblem) {
     SCOPED_TRACE(c.name);
     PoseGraph bad = good;
     c.mutate(&bad);
-    EXPECT_FALSE(ValidatePoseGraph(bad, AllowLandmarks(), &error));
+    EXPECT_FALSE(ValidatePoseGraph(bad, ValidationOptions(), &error));
     EXPECT_NE(error.find(c.contains), std::string::npos) << error;
   }
 }
@@ -209,7 +203,7 @@ PoseGraph TwoIslands() {
 TEST(LandmarkValidationTest, ConnectivityCountsLandmarksAndPriors) {
   std::string error;
   PoseGraph g = TwoIslands();
-  EXPECT_FALSE(ValidatePoseGraph(g, AllowLandmarks(), &error));
+  EXPECT_FALSE(ValidatePoseGraph(g, ValidationOptions(), &error));
   // A landmark seen from both islands connects them.
   PoseGraph linked = g;
   const int l = linked.AddLandmark(10);
@@ -219,7 +213,7 @@ TEST(LandmarkValidationTest, ConnectivityCountsLandmarksAndPriors) {
   std::vector<int> label;
   EXPECT_EQ(ConnectedComponents(linked, &label), 1);
   EXPECT_EQ(label.size(), 5u);  // Four poses and one landmark.
-  EXPECT_TRUE(ValidatePoseGraph(linked, AllowLandmarks(), &error)) << error;
+  EXPECT_TRUE(ValidatePoseGraph(linked, ValidationOptions(), &error)) << error;
   // Landmarks seen only within each island: still two components.
   PoseGraph separate = g;
   separate.AddLandmark(10);
@@ -227,7 +221,7 @@ TEST(LandmarkValidationTest, ConnectivityCountsLandmarksAndPriors) {
   separate.landmark_measurements.push_back({0, 0, Eigen::Vector2d(1, 0), 1.0});
   separate.landmark_measurements.push_back({3, 1, Eigen::Vector2d(1, 0), 1.0});
   EXPECT_EQ(ConnectedComponents(separate, nullptr), 2);
-  EXPECT_FALSE(ValidatePoseGraph(separate, AllowLandmarks(), &error));
+  EXPECT_FALSE(ValidatePoseGraph(separate, ValidationOptions(), &error));
   EXPECT_NE(error.find("disconnected"), std::string::npos) << error;
   // A prior on each island ties both to the world frame: no FIX, no edge
   // between them needed.
@@ -237,7 +231,7 @@ TEST(LandmarkValidationTest, ConnectivityCountsLandmarksAndPriors) {
   prior.tau = 1;
   prior.i = 0;
   anchored.priors.push_back(prior);
-  EXPECT_FALSE(ValidatePoseGraph(anchored, AllowLandmarks(), &error));
+  EXPECT_FALSE(ValidatePoseGraph(anchored, ValidationOptions(), &error));
   // A rotation-only prior on the other island links it in rotation only:
   // its translation would be free.
   PoseGraph rotation_only = anchored;
@@ -248,7 +242,7 @@ TEST(LandmarkValidationTest, ConnectivityCountsLandmarksAndPriors) {
   rotation_only.priors.push_back(prior);
   EXPECT_EQ(ConnectedComponents(rotation_only, nullptr), 1);
   EXPECT_EQ(TranslationalComponents(rotation_only, nullptr), 2);
-  EXPECT_FALSE(ValidatePoseGraph(rotation_only, AllowLandmarks(), &error));
+  EXPECT_FALSE(ValidatePoseGraph(rotation_only, ValidationOptions(), &error));
   EXPECT_NE(error.find("translational terms are disconnected"),
             std::string::npos)
       << error;
@@ -256,46 +250,43 @@ TEST(LandmarkValidationTest, ConnectivityCountsLandmarksAndPriors) {
   prior.tau = 3;
   anchored.priors.push_back(prior);
   EXPECT_EQ(TranslationalComponents(anchored, nullptr), 1);
-  EXPECT_TRUE(ValidatePoseGraph(anchored, AllowLandmarks(), &error)) << error;
+  EXPECT_TRUE(ValidatePoseGraph(anchored, ValidationOptions(), &error))
+      << error;
   // Rotation-only priors on a connected graph are fine.
   PoseGraph rotations = linked;
   prior.tau = 0;
   rotations.priors.push_back(prior);
-  EXPECT_TRUE(ValidatePoseGraph(rotations, AllowLandmarks(), &error)) << error;
+  EXPECT_TRUE(ValidatePoseGraph(rotations, ValidationOptions(), &error))
+      << error;
   EXPECT_EQ(anchored.fixed_pose, -1);
 }
 
 // The solver core does not handle landmarks and priors yet: it must refuse
 // such graphs explicitly (issue #15), never ignore the extra terms.
-TEST(LandmarkValidationTest, SolverCoreRefusesLandmarksAndPriorsExplicitly) {
+// The solver core takes landmarks and priors (issue #15); the overloads that
+// cannot carry landmark positions say so instead of ignoring them.
+TEST(LandmarkValidationTest, SolverCoreAcceptsLandmarksAndPriors) {
   Solution truth;
   const PoseGraph g = LandmarkGraph(3, 6, &truth);
+  ASSERT_GT(g.num_landmarks, 0);
+  ASSERT_FALSE(g.priors.empty());
   std::string error;
-  EXPECT_FALSE(ValidatePoseGraph(g, &error));
-  EXPECT_NE(error.find("do not support landmarks and priors yet"),
-            std::string::npos)
-      << error;
+  EXPECT_TRUE(ValidatePoseGraph(g, &error)) << error;
   SolverSummary summary;
-  Solve(g, SolverOptions(), &summary);
-  EXPECT_EQ(summary.status, SolverSummary::Status::kInvalidInput);
-  EXPECT_NE(summary.message.find("landmarks and priors"), std::string::npos)
-      << summary.message;
+  Solution x;
+  Solve(g, SolverOptions(), &x, &summary);
+  EXPECT_TRUE(summary.certified()) << summary.FullReport();
+  EXPECT_EQ(static_cast<int>(x.landmarks.size()), g.num_landmarks);
+  EXPECT_EQ(summary.num_landmarks, g.num_landmarks);
+  EXPECT_EQ(summary.num_priors, static_cast<int>(g.priors.size()));
   Certificate certificate;
-  EXPECT_FALSE(Certify(g, truth.poses, {}, &certificate, &error));
-  EXPECT_NE(error.find("landmarks and priors"), std::string::npos) << error;
-  Poses chordal;
-  EXPECT_FALSE(ChordalInitialization(g, &chordal, &error));
-  EXPECT_NE(error.find("landmarks and priors"), std::string::npos) << error;
-  // Priors alone are refused as well; the pose graph without the extra
-  // terms is fine.
-  PoseGraph priors_only = g;
-  priors_only.landmark_measurements.clear();
-  priors_only.landmark_ids.clear();
-  priors_only.index_of_landmark_id.clear();
-  priors_only.num_landmarks = 0;
-  EXPECT_FALSE(ValidatePoseGraph(priors_only, &error));
-  priors_only.priors.clear();
-  EXPECT_TRUE(ValidatePoseGraph(priors_only, &error)) << error;
+  EXPECT_TRUE(Certify(g, x, {}, &certificate, &error)) << error;
+  EXPECT_TRUE(certificate.certified) << certificate.FullReport();
+  EXPECT_FALSE(Certify(g, x.poses, {}, &certificate, &error));
+  EXPECT_NE(error.find("landmark"), std::string::npos) << error;
+  Solution chordal;
+  EXPECT_TRUE(ChordalInitialization(g, &chordal, &error)) << error;
+  EXPECT_EQ(static_cast<int>(chordal.landmarks.size()), g.num_landmarks);
 }
 
 }  // namespace

@@ -10,9 +10,12 @@
 
 #include "ceres_sesync/internal/sesync_problem.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Eigen/Dense"
@@ -107,7 +110,8 @@ TEST(SESyncProblem, MultiplyQMatchesDenseQ) {
     SESyncProblem problem(graph);
     ASSERT_TRUE(problem.ok());
     EXPECT_EQ(problem.dimension(), o.dimension);
-    EXPECT_EQ(problem.num_poses(), o.num_poses);
+    EXPECT_EQ(problem.num_rotations(), o.num_poses);
+    EXPECT_EQ(problem.num_translations(), o.num_poses);
     const MatrixXd Q = DenseQ(graph);
     for (int r : {1, o.dimension, o.dimension + 2}) {
       const MatrixXd Y = Gaussian(r, o.dimension * o.num_poses, &rng);
@@ -212,21 +216,258 @@ TEST(SESyncProblem, BlockDiagonalMultiplyMatchesDense) {
 }
 
 // ---------------------------------------------------------------------------
+// Landmarks and priors: the index sets of ProblemLayout (sesync_problem.h),
+// checked against DenseLandmarkDataMatrix (built residual by residual in the
+// test, independent of ForEachDataTerm).
+
+struct LandmarkCase {
+  std::string name;
+  test_util::RandomLandmarkGraphOptions options;
+};
+
+// Landmarks only, each kind of prior alone, all together; trees (no loop
+// closures) and landmarks seen by a single pose; 2D and 3D.
+std::vector<LandmarkCase> LandmarkGraphFamily() {
+  std::vector<LandmarkCase> family;
+  uint64_t seed = 500;
+  for (int d : {2, 3}) {
+    for (int n : {1, 3, 15}) {
+      for (int kind = 0; kind < 5; ++kind) {
+        LandmarkCase c;
+        auto& o = c.options;
+        o.poses.dimension = d;
+        o.poses.num_poses = n;
+        o.poses.num_loop_closures = n / 3;
+        o.poses.kappa = kind == 4 ? 500 : 20;
+        o.poses.tau = kind == 4 ? 0.5 : 10;
+        o.poses.seed = seed++;
+        o.num_landmarks = n == 1 ? 3 : 2 * n;
+        o.observations_per_landmark = kind == 0 ? 1 : 3;
+        o.nu = 7;
+        const char* names[] = {"landmarks seen once", "position priors",
+                               "rotation priors", "pose priors",
+                               "all priors, anisotropic"};
+        c.name = std::string(names[kind]) + " d " + std::to_string(d) + " n " +
+                 std::to_string(n);
+        if (kind == 1) o.num_position_priors = 2;
+        if (kind == 2) o.num_rotation_priors = 2;
+        if (kind == 3) o.num_pose_priors = 1;
+        if (kind == 4) {
+          o.num_position_priors = 2;
+          o.num_rotation_priors = 1;
+          o.num_pose_priors = 1;
+          o.prior_kappa = 1e4;
+          o.prior_tau = 0.1;
+        }
+        // A single pose with rotation priors only has nothing to place its
+        // translation but itself; keep it (the gauge is pose 0 then).
+        family.push_back(c);
+      }
+    }
+  }
+  return family;
+}
+
+// The two dense routes to Q agree (pseudo-inverse of the whole translation
+// block vs Cholesky of the reduced one): guards the references.
+TEST(DenseReference, LandmarkSchurComplementsAgree) {
+  for (const LandmarkCase& c : LandmarkGraphFamily()) {
+    const PoseGraph graph = test_util::RandomLandmarkGraph(c.options, nullptr);
+    ASSERT_TRUE(ValidatePoseGraph(graph, nullptr)) << c.name;
+    const test_util::DenseLandmarkProblem dense =
+        test_util::BuildDenseLandmarkProblem(graph);
+    // Relative to Q, or to D where Q is zero (a single pose whose landmarks
+    // are each seen once: any rotation fits them exactly).
+    EXPECT_LT((dense.Q - test_util::DenseLandmarkQ(graph)).norm(),
+              1e-10 * std::max(dense.Q.norm(), dense.D.norm()))
+        << c.name;
+  }
+}
+
+// The layout's sizes and the sparse D, Vbar, Lbar equal the dense blocks in
+// the documented index sets (landmarks after the poses, t_w last and the
+// gauge when some prior has a position term, R_w after the poses).
+TEST(SESyncProblem, LandmarkBlocksMatchDenseDataMatrix) {
+  for (const LandmarkCase& c : LandmarkGraphFamily()) {
+    const PoseGraph graph = test_util::RandomLandmarkGraph(c.options, nullptr);
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok()) << c.name;
+    const int n = graph.num_poses, L = graph.num_landmarks;
+    bool position = false;
+    for (const PosePrior& p : graph.priors) position |= p.has_position();
+    EXPECT_EQ(problem.num_rotations(), n + (graph.priors.empty() ? 0 : 1));
+    EXPECT_EQ(problem.num_translations(), n + L + (position ? 1 : 0));
+    EXPECT_EQ(problem.layout().gauge(), position ? n + L : 0);
+    const test_util::DenseLandmarkProblem dense =
+        test_util::BuildDenseLandmarkProblem(graph);
+    const double scale = dense.D.norm() + dense.Lbar.norm();
+    EXPECT_LT((MatrixXd(problem.D()) - dense.D).norm(), 1e-13 * scale)
+        << c.name;
+    EXPECT_LT((MatrixXd(problem.Vbar()) - dense.Vbar).norm(), 1e-13 * scale)
+        << c.name;
+    EXPECT_LT((MatrixXd(problem.Lbar()) - dense.Lbar).norm(), 1e-13 * scale)
+        << c.name;
+    // One vertex per pose, landmark and (with priors) the world.
+    std::vector<int> ordering = problem.vertex_ordering();
+    std::sort(ordering.begin(), ordering.end());
+    std::vector<int> expected(n + L + (graph.priors.empty() ? 0 : 1));
+    std::iota(expected.begin(), expected.end(), 0);
+    EXPECT_EQ(ordering, expected) << c.name;
+  }
+}
+
+TEST(SESyncProblem, LandmarkMultiplyQMatchesDenseQ) {
+  std::mt19937_64 rng(41);
+  for (const LandmarkCase& c : LandmarkGraphFamily()) {
+    const PoseGraph graph = test_util::RandomLandmarkGraph(c.options, nullptr);
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok());
+    const MatrixXd Q = test_util::DenseLandmarkQ(graph);
+    const double D_norm = MatrixXd(problem.D()).norm();
+    const int d = graph.dimension;
+    ASSERT_EQ(Q.rows(), d * problem.num_rotations());
+    for (int r : {1, d + 2}) {
+      const MatrixXd Y = Gaussian(r, static_cast<int>(Q.rows()), &rng);
+      MatrixXd YQ;
+      problem.MultiplyQ(Y, &YQ);
+      // As for pose graphs: sparse products and one solve, 1e-10 (relative
+      // to D where Q vanishes).
+      EXPECT_LT((YQ - Y * Q).norm(),
+                1e-10 * std::max(Q.norm(), D_norm) * Y.norm())
+          << c.name << " r " << r;
+    }
+  }
+}
+
+// The recovered translations and landmark positions are the minimizers of F
+// for the rotations: F(x) equals <R, R Q> there, and perturbing any of them
+// does not decrease F (stationary, convex). R_w = I and (when present)
+// t_w = 0, so the solver's frame is the world frame.
+TEST(SESyncProblem, LandmarkRecoverTranslationsIsOptimal) {
+  std::mt19937_64 rng(43);
+  for (const LandmarkCase& c : LandmarkGraphFamily()) {
+    Solution truth;
+    const PoseGraph graph = test_util::RandomLandmarkGraph(c.options, &truth);
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok());
+    const int d = graph.dimension, n = graph.num_poses, L = graph.num_landmarks;
+    const MatrixXd R = test_util::StackSolverRotations(graph, truth.poses);
+    const MatrixXd T = problem.RecoverTranslations(R);
+    ASSERT_EQ(T.rows(), d);
+    ASSERT_EQ(T.cols(), problem.num_translations());
+    EXPECT_EQ(T.col(problem.layout().gauge()).norm(), 0.0);
+    auto solution = [&](const MatrixXd& translations) {
+      Solution x;
+      for (int i = 0; i < n; ++i) {
+        x.poses.push_back(Pose{truth.poses[i].R, translations.col(i)});
+      }
+      for (int l = 0; l < L; ++l)
+        x.landmarks.push_back(translations.col(n + l));
+      return x;
+    };
+    const double f = EvaluateObjective(graph, solution(T));
+    MatrixXd RQ;
+    problem.MultiplyQ(R, &RQ);
+    // F is a sum of nonnegative terms: 1e-10 relative, plus the round-off
+    // of the implicit Q's cancellation where F vanishes (1e-12 of the
+    // data's scale tr(D)).
+    const double floor = 1e-12 * MatrixXd(problem.D()).trace();
+    EXPECT_NEAR(Inner(R, RQ), f, 1e-10 * f + floor) << c.name;
+    for (int trial = 0; trial < 4; ++trial) {
+      MatrixXd P = Gaussian(d, static_cast<int>(T.cols()), &rng);
+      P.col(problem.layout().gauge()).setZero();  // t_w stays at 0.
+      const double s = 0.3;
+      const double f_plus = EvaluateObjective(graph, solution(T + s * P));
+      const double f_minus = EvaluateObjective(graph, solution(T - s * P));
+      const double curvature = f_plus + f_minus - 2 * f;
+      EXPECT_GE(f_plus, f - 1e-12 * f) << c.name;
+      EXPECT_GE(f_minus, f - 1e-12 * f) << c.name;
+      EXPECT_LE(std::abs(f_plus - f_minus),
+                1e-9 * curvature + 1e-12 * (f_plus + f_minus))
+          << c.name;
+    }
+  }
+}
+
+// Rounding bounds: every stored entry of M (in the documented index sets)
+// is within its row's bound of the exact value recomputed here in long
+// double (a sum of the same terms; long double's extra digits make its own
+// error negligible against the bound).
+TEST(SESyncProblem, LandmarkRowRoundingBoundsCoverTheStoredMatrices) {
+  for (const LandmarkCase& c : LandmarkGraphFamily()) {
+    const PoseGraph graph = test_util::RandomLandmarkGraph(c.options, nullptr);
+    SESyncProblem problem(graph);
+    const int d = graph.dimension;
+    const int N = problem.num_translations(), dn = d * problem.num_rotations();
+    using LongMatrix =
+        Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+    LongMatrix lw = LongMatrix::Zero(N, N), v = LongMatrix::Zero(N, dn),
+               dd = LongMatrix::Zero(dn, dn);
+    internal::ForEachDataTerm<long double>(
+        graph, [&](internal::DataBlock block, int row, int col, long double x) {
+          switch (block) {
+            case internal::DataBlock::kTranslation:
+              lw(row, col) += x;
+              return;
+            case internal::DataBlock::kCoupling:
+              v(row, col) += x;
+              return;
+            default:
+              dd(row, col) += x;
+          }
+        });
+    const MatrixXd D(problem.D()), V(problem.Vbar()), Lbar(problem.Lbar());
+    for (int q = 0; q < dn; ++q) {
+      long double row = 0;
+      for (int b = 0; b < dn; ++b) row += std::abs(D(q, b) - dd(q, b));
+      for (int k = 0; k < N; ++k) {
+        const int j = problem.layout().reduced(k);
+        if (j >= 0) row += std::abs(-V(j, q) - -v(k, q));
+      }
+      EXPECT_LE(static_cast<double>(row), problem.rotation_row_rounding()[q])
+          << c.name;
+    }
+    for (int k = 0; k < N; ++k) {
+      const int j = problem.layout().reduced(k);
+      if (j < 0) continue;
+      long double row = 0;
+      for (int l = 0; l < N; ++l) {
+        const int i = problem.layout().reduced(l);
+        if (i >= 0) row += std::abs(Lbar(j, i) - lw(k, l));
+      }
+      for (int q = 0; q < dn; ++q) row += std::abs(V(j, q) - v(k, q));
+      EXPECT_LE(static_cast<double>(row), problem.translation_row_rounding()[k])
+          << c.name;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
 // SESyncCost: F(Y) = tr(Q Y^T Y) on St(d, r)^n.
 
+// The reference Q of any graph: DenseQ for pose graphs, DenseLandmarkQ
+// (rotation blocks of the solver) with landmarks and priors.
+MatrixXd ReferenceQ(const PoseGraph& graph) {
+  return graph.has_landmarks_or_priors() ? test_util::DenseLandmarkQ(graph)
+                                         : DenseQ(graph);
+}
+
 struct CostFixture {
-  explicit CostFixture(const RandomGraphOptions& o,
+  explicit CostFixture(PoseGraph g,
                        PreconditionerType type = PreconditionerType::kNone)
-      : graph(RandomPoseGraph(o, nullptr)),
+      : graph(std::move(g)),
         problem(graph),
         preconditioner(problem, type, 1e6),
         cost(&problem, &preconditioner),
-        Q(DenseQ(graph)) {}
+        Q(ReferenceQ(graph)),
+        d(graph.dimension),
+        n(problem.num_rotations()) {}
   PoseGraph graph;
   SESyncProblem problem;
   SESyncPreconditioner preconditioner;
   SESyncCost cost;
   MatrixXd Q;
+  int d, n;  // Dimension, rotation blocks.
 };
 
 MatrixXd RandomTangent(const MatrixXd& Y, int d, std::mt19937_64* rng) {
@@ -235,8 +476,10 @@ MatrixXd RandomTangent(const MatrixXd& Y, int d, std::mt19937_64* rng) {
   return V;
 }
 
-std::vector<RandomGraphOptions> CostGraphs() {
-  std::vector<RandomGraphOptions> graphs;
+// Pose graphs and graphs with landmarks and priors (landmarks change Q
+// through the eliminated translations; priors add the world block R_w).
+std::vector<PoseGraph> CostGraphs() {
+  std::vector<PoseGraph> graphs;
   for (int d : {2, 3}) {
     RandomGraphOptions o;
     o.dimension = d;
@@ -245,18 +488,34 @@ std::vector<RandomGraphOptions> CostGraphs() {
     o.kappa = 20;
     o.tau = 10;
     o.seed = 100 + d;
-    graphs.push_back(o);
+    graphs.push_back(RandomPoseGraph(o, nullptr));
+    test_util::RandomLandmarkGraphOptions l;
+    l.poses = o;
+    l.poses.num_loop_closures = 3;
+    l.poses.seed = 200 + d;
+    l.num_landmarks = 20;
+    l.observations_per_landmark = 3;
+    l.nu = 15;
+    graphs.push_back(test_util::RandomLandmarkGraph(l, nullptr));
+    l.poses.seed = 300 + d;
+    l.num_position_priors = 3;
+    l.num_rotation_priors = 1;
+    l.num_pose_priors = 1;
+    graphs.push_back(test_util::RandomLandmarkGraph(l, nullptr));
   }
   return graphs;
 }
 
 TEST(SESyncCost, ValueAndLambdaMatchDense) {
   std::mt19937_64 rng(19);
-  for (const RandomGraphOptions& o : CostGraphs()) {
-    CostFixture fx(o);
-    const int d = o.dimension;
+  for (const PoseGraph& graph : CostGraphs()) {
+    CostFixture fx(graph);
+    const int d = fx.d, n = fx.n;
+    SCOPED_TRACE(testing::Message()
+                 << "d " << d << " landmarks " << graph.num_landmarks
+                 << " priors " << graph.priors.size());
     for (int r : {d, d + 1, d + 3}) {
-      const MatrixXd Y = RandomStiefelProductPoint(d, r, o.num_poses, &rng);
+      const MatrixXd Y = RandomStiefelProductPoint(d, r, n, &rng);
       const double f = fx.cost.Evaluate(Y);
       const double f_dense = (Y * fx.Q * Y.transpose()).trace();
       EXPECT_NEAR(f, f_dense, 1e-10 * std::abs(f_dense));
@@ -264,8 +523,8 @@ TEST(SESyncCost, ValueAndLambdaMatchDense) {
       const MatrixXd QYY = fx.Q * Y.transpose() * Y;
       const MatrixXd& Lambda = fx.cost.Lambda();
       ASSERT_EQ(Lambda.rows(), d);
-      ASSERT_EQ(Lambda.cols(), d * o.num_poses);
-      for (int i = 0; i < o.num_poses; ++i) {
+      ASSERT_EQ(Lambda.cols(), d * n);
+      for (int i = 0; i < n; ++i) {
         const MatrixXd B = QYY.block(d * i, d * i, d, d);
         EXPECT_LT(
             (Lambda.middleCols(d * i, d) - 0.5 * (B + B.transpose())).norm(),
@@ -278,12 +537,15 @@ TEST(SESyncCost, ValueAndLambdaMatchDense) {
 // d/dt F(R_Y(t V)) at t = 0 equals <grad F(Y), V> (central differences).
 TEST(SESyncCost, GradientMatchesFiniteDifferencesAlongRetraction) {
   std::mt19937_64 rng(23);
-  for (const RandomGraphOptions& o : CostGraphs()) {
-    CostFixture fx(o);
-    const int d = o.dimension;
+  for (const PoseGraph& graph : CostGraphs()) {
+    CostFixture fx(graph);
+    const int d = fx.d, n = fx.n;
+    SCOPED_TRACE(testing::Message()
+                 << "d " << d << " landmarks " << graph.num_landmarks
+                 << " priors " << graph.priors.size());
     for (int r : {d, d + 2}) {
       for (int trial = 0; trial < 3; ++trial) {
-        const MatrixXd Y = RandomStiefelProductPoint(d, r, o.num_poses, &rng);
+        const MatrixXd Y = RandomStiefelProductPoint(d, r, n, &rng);
         fx.cost.Evaluate(Y);
         MatrixXd g;
         fx.cost.Gradient(&g);
@@ -315,12 +577,15 @@ TEST(SESyncCost, GradientMatchesFiniteDifferencesAlongRetraction) {
 // and at a point near a critical point.
 TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
   std::mt19937_64 rng(29);
-  for (const RandomGraphOptions& o : CostGraphs()) {
-    CostFixture fx(o);
-    const int d = o.dimension;
+  for (const PoseGraph& graph : CostGraphs()) {
+    CostFixture fx(graph);
+    const int d = fx.d, n = fx.n;
+    SCOPED_TRACE(testing::Message()
+                 << "d " << d << " landmarks " << graph.num_landmarks
+                 << " priors " << graph.priors.size());
     for (int r : {d, d + 2}) {
       for (int trial = 0; trial < 3; ++trial) {
-        const MatrixXd Y = RandomStiefelProductPoint(d, r, o.num_poses, &rng);
+        const MatrixXd Y = RandomStiefelProductPoint(d, r, n, &rng);
         const MatrixXd V = RandomTangent(Y, d, &rng);
         const MatrixXd U = RandomTangent(Y, d, &rng);
         const double h = 1e-5;
@@ -354,12 +619,11 @@ TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
 // definite on the tangent space (the operator Proj o P o Proj).
 TEST(SESyncPreconditioner, AllTypesAreDocumentedOperatorsAndSpdOnTangent) {
   std::mt19937_64 rng(31);
-  for (const RandomGraphOptions& o : CostGraphs()) {
-    const int d = o.dimension, n = o.num_poses, dn = d * n;
-    const PoseGraph graph = RandomPoseGraph(o, nullptr);
+  for (const PoseGraph& graph : CostGraphs()) {
     SESyncProblem problem(graph);
     ASSERT_TRUE(problem.ok());
-    const MatrixXd Q = DenseQ(graph);
+    const int d = graph.dimension, n = problem.num_rotations(), dn = d * n;
+    const MatrixXd Q = ReferenceQ(graph);
     const MatrixXd D = MatrixXd(problem.D());
     // eps = Gershgorin bound on lambda_max(D) / max_condition (documented).
     const double max_condition = 1e6;

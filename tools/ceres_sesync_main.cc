@@ -67,8 +67,12 @@ const std::vector<Command>& Commands() {
        "solve with SE-Sync and certify the result",
        "Solves the pose graph with SE-Sync (Riemannian staircase, rounding) "
        "and proves the result globally optimal when the relaxation is exact. "
-       "Exit code 0 when certified, 1 when not.",
-       {{"output", "Write the solution (VERTEX lines) to this g2o file."},
+       "Landmarks and priors are part of the problem; with priors the "
+       "solution is in their world frame. Exit code 0 when certified, 1 when "
+       "not.",
+       {{"output",
+         "Write the solution (VERTEX lines: poses, then landmark positions, "
+         "original ids) to this g2o file."},
         {"tum"},
         {"json"},
         {"components"},
@@ -88,15 +92,17 @@ const std::vector<Command>& Commands() {
        ceres_sesync::tools::RunCertify,
        "GRAPH.g2o POSES.g2o",
        "certify a given solution (e.g. from Ceres)",
-       "Proves the poses of POSES.g2o (VERTEX lines, matched by id) globally "
-       "optimal for GRAPH.g2o, or gives a proven lower bound on the optimum "
-       "and a suboptimality bound. Exit code 0 when certified, 1 when not.",
+       "Proves the poses of POSES.g2o (VERTEX lines, matched by id; landmark "
+       "VERTEX_XY / VERTEX_TRACKXYZ lines too when the graph has landmarks) "
+       "globally optimal for GRAPH.g2o, or gives a proven lower bound on the "
+       "optimum and a suboptimality bound. Exit code 0 when certified, 1 "
+       "when not.",
        {{"json"},
         {"max_relative_suboptimality"},
         {"improve"},
         {"output",
-         "With --improve: write the improved poses to this g2o "
-         "file."},
+         "With --improve: write the improved solution (poses and landmarks) "
+         "to this g2o file."},
         {"num_threads"},
         {"proof_arithmetic"},
         {"progress", "With --improve: show the solve's progress (see solve)."},

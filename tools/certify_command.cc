@@ -34,8 +34,9 @@ int RunCertify(const Args& args) {
     std::fprintf(stderr, "ceres_sesync certify: %s\n", error.c_str());
     return kUsageOrInputError;
   }
-  Poses poses;
-  if (!ReadG2oPoses(args[1], graph, &poses, &error)) {
+  // The poses and (for a graph with landmarks) the landmark positions.
+  Solution candidate;
+  if (!ReadG2oSolution(args[1], graph, &candidate, &error)) {
     std::fprintf(stderr, "ceres_sesync certify: %s\n", error.c_str());
     return kUsageOrInputError;
   }
@@ -57,7 +58,7 @@ int RunCertify(const Args& args) {
   if (FLAGS_improve) progress = ProgressPrinterFromFlags();
   if (progress) options.solver_options.progress = progress->Callback();
   Certificate certificate;
-  const bool ok = Certify(graph, poses, options, &certificate, &error);
+  const bool ok = Certify(graph, candidate, options, &certificate, &error);
   if (progress) progress->Finish();
   if (!ok) {
     std::fprintf(stderr, "ceres_sesync certify: %s: %s\n", args[1].c_str(),
@@ -66,7 +67,10 @@ int RunCertify(const Args& args) {
   }
   std::cout << certificate.FullReport() << std::flush;
   if (certificate.has_improved_poses && !FLAGS_output.empty() &&
-      !WriteG2oPoses(FLAGS_output, graph, certificate.improved_poses, &error)) {
+      !WriteG2oSolution(
+          FLAGS_output, graph,
+          Solution{certificate.improved_poses, certificate.improved_landmarks},
+          &error)) {
     std::fprintf(stderr, "ceres_sesync certify: %s\n", error.c_str());
     return kUsageOrInputError;
   }
@@ -74,6 +78,8 @@ int RunCertify(const Args& args) {
     internal::JsonWriter json;
     json.String("graph", args[0]);
     json.String("poses", args[1]);
+    json.Int("num_landmarks", graph.num_landmarks);
+    json.Int("num_priors", static_cast<int>(graph.priors.size()));
     json.Number("objective", certificate.objective);
     json.Number("rotation_objective", certificate.rotation_objective);
     json.Number("lambda_min", certificate.lambda_min);

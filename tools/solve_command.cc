@@ -43,6 +43,9 @@ namespace {
 void AddSummary(const SolverSummary& summary, internal::JsonWriter* json) {
   json->Int("num_poses", summary.num_poses);
   json->Int("num_measurements", summary.num_measurements);
+  json->Int("num_landmarks", summary.num_landmarks);
+  json->Int("num_landmark_measurements", summary.num_landmark_measurements);
+  json->Int("num_priors", summary.num_priors);
   json->Int("dimension", summary.dimension);
   json->Number("objective", summary.objective);
   json->Number("sdp_value", summary.sdp_value);
@@ -179,13 +182,13 @@ int RunSolve(const Args& args) {
   std::unique_ptr<ProgressPrinter> progress = ProgressPrinterFromFlags();
   if (progress) options.progress = progress->Callback();
 
-  Poses poses;
+  Solution solution;
   bool certified = false;
   internal::JsonWriter json;
   json.String("graph", path);
   if (FLAGS_components) {
     ComponentsSummary summary;
-    poses = SolveByComponent(graph, options, &summary);
+    solution.poses = SolveByComponent(graph, options, &summary);
     if (progress) progress->Finish();
     std::cout << summary.FullReport() << std::flush;
     if (summary.status == SolverSummary::Status::kInvalidInput) {
@@ -195,7 +198,7 @@ int RunSolve(const Args& args) {
     AddComponents(graph, summary, &json);
   } else {
     SolverSummary summary;
-    poses = Solve(graph, options, &summary);
+    Solve(graph, options, &solution, &summary);
     if (progress) progress->Finish();
     std::cout << summary.FullReport() << std::flush;
     if (summary.status == SolverSummary::Status::kInvalidInput) {
@@ -204,11 +207,13 @@ int RunSolve(const Args& args) {
     certified = summary.certified();
     AddSummary(summary, &json);
   }
+  // The poses, then the landmark positions (original ids).
   if (!FLAGS_output.empty() &&
-      !WriteG2oPoses(FLAGS_output, graph, poses, &error)) {
+      !WriteG2oSolution(FLAGS_output, graph, solution, &error)) {
     return InputError(error);
   }
-  if (!FLAGS_tum.empty() && !WriteTumFile(FLAGS_tum, graph, poses, &error)) {
+  if (!FLAGS_tum.empty() &&
+      !WriteTumFile(FLAGS_tum, graph, solution.poses, &error)) {
     return InputError(error);
   }
   if (!FLAGS_json.empty() && !json.WriteToFile(FLAGS_json, &error)) {

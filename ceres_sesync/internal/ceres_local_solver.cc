@@ -15,7 +15,7 @@ class BurerMonteiroCost : public ceres::FirstOrderFunction {
       : problem_(problem), r_(r) {}
   bool Evaluate(const double* parameters, double* cost,
                 double* gradient) const override {
-    const int columns = problem_->dimension() * problem_->num_poses();
+    const int columns = problem_->dimension() * problem_->num_rotations();
     const Eigen::Map<const Eigen::MatrixXd> Y(parameters, r_, columns);
     Eigen::MatrixXd YQ;
     problem_->MultiplyQ(Y, &YQ);
@@ -24,7 +24,7 @@ class BurerMonteiroCost : public ceres::FirstOrderFunction {
     return true;
   }
   int NumParameters() const override {
-    return r_ * problem_->dimension() * problem_->num_poses();
+    return r_ * problem_->dimension() * problem_->num_rotations();
   }
 
  private:
@@ -42,7 +42,8 @@ void MinimizeWithCeresLbfgs(const SESyncProblem& problem, int max_iterations,
   const int r = static_cast<int>(Y->rows());
   ceres::GradientProblem gradient_problem(
       new BurerMonteiroCost(&problem, r),
-      new StiefelProductManifold(problem.dimension(), r, problem.num_poses()));
+      new StiefelProductManifold(problem.dimension(), r,
+                                 problem.num_rotations()));
   ceres::GradientProblemSolver::Options options;
   options.line_search_direction_type = ceres::LBFGS;
   options.max_num_iterations = max_iterations;

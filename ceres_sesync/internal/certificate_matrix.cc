@@ -16,19 +16,27 @@ constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
 
 namespace {
 
-// A fill-reducing ordering of K from one of the pose graph: K has the pattern
-// of the translational Laplacian with every vertex expanded into its
-// translation (absent for vertex 0) and d rotation unknowns, so ordering the
-// n vertices (1 / (d+1)^2 of K's entries) and expanding gives K's ordering at
-// a fraction of the cost of ordering K itself.
+// A fill-reducing ordering of K from one of the vertices: K has the pattern
+// of M collapsed to vertices (the translational Laplacian of a pose graph)
+// with every vertex expanded into its translation (absent for the gauge
+// node and for a world vertex without t_w) and its d rotation unknowns
+// (absent for landmarks), so ordering the vertices (about 1 / (d+1)^2 of K's
+// entries) and expanding gives K's ordering at a fraction of the cost of
+// ordering K itself.
 std::vector<int> BlockOrdering(const SESyncProblem& problem) {
-  const int n = problem.num_poses(), d = problem.dimension();
-  const int t0 = n - 1;
+  const ProblemLayout& layout = problem.layout();
+  const int n = problem.num_rotations(), d = problem.dimension();
+  const int t0 = problem.num_translations() - 1;
   std::vector<int> ordering;
   ordering.reserve(t0 + d * n);
   for (int v : problem.vertex_ordering()) {
-    if (v > 0) ordering.push_back(v - 1);
-    for (int a = 0; a < d; ++a) ordering.push_back(t0 + d * v + a);
+    const int node = layout.translation_of_vertex(v);
+    if (node >= 0 && layout.reduced(node) >= 0) {
+      ordering.push_back(layout.reduced(node));
+    }
+    const int block = layout.rotation_of_vertex(v);
+    if (block < 0) continue;
+    for (int a = 0; a < d; ++a) ordering.push_back(t0 + d * block + a);
   }
   return ordering;
 }
@@ -42,9 +50,9 @@ const char* ProofPrecisionName(ProofPrecision precision) {
 CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
     : problem_(problem),
       d_(problem.dimension()),
-      n_(problem.num_poses()),
-      translation_size_(problem.num_poses() - 1),
-      rotation_size_(problem.dimension() * problem.num_poses()) {
+      n_(problem.num_rotations()),
+      translation_size_(problem.num_translations() - 1),
+      rotation_size_(problem.dimension() * problem.num_rotations()) {
   CHECK_LE(d_, 3);  // Assemble's row sums.
   const int t0 = translation_size_, d = d_;
   std::vector<Triplet> triplets;
@@ -103,8 +111,9 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
     }
   }
   data_rounding_.resize(size);
-  for (int j = 0; j < t0; ++j) {
-    data_rounding_[j] = problem.translation_row_rounding()[j + 1];
+  for (int k = 0; k < problem.num_translations(); ++k) {
+    const int j = problem.layout().reduced(k);
+    if (j >= 0) data_rounding_[j] = problem.translation_row_rounding()[k];
   }
   for (int q = 0; q < rotation_size_; ++q) {
     data_rounding_[t0 + q] = problem.rotation_row_rounding()[q];
@@ -280,25 +289,28 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
   // K_c from the measurements: the data terms in double-double (products
   // of two doubles exact, of three within 5u^2, sums within 3.2u^2) and
   // per-row sums of |terms| with their counts for the assembly's bound.
+  // Translation nodes map to K's rows through ProblemLayout::reduced (the
+  // gauge node, fixed at 0, has none), rotation indices q to t0 + q.
   std::vector<DoubleDouble> base(K_.nonZeros());
   std::vector<double> abs_sum(size, 0.0);
   std::vector<int> count(size, 0);
+  const ProblemLayout& layout = problem_.layout();
   ForEachDataTerm<DoubleDouble>(
       problem_.graph(),
       [&](DataBlock block, int row, int col, const DoubleDouble& value) {
         const double magnitude = value.AbsUpperBound();
         switch (block) {
           case DataBlock::kTranslation: {
-            if (row == 0 || col == 0) return;  // The gauge: t_0 = 0.
-            const int r = row - 1, s = col - 1;
+            const int r = layout.reduced(row), s = layout.reduced(col);
+            if (r < 0 || s < 0) return;  // The gauge node: fixed at 0.
             abs_sum[r] += magnitude;
             ++count[r];
             if (r >= s) base[index(r, s)] += value;
             return;
           }
-          case DataBlock::kCoupling: {  // -V at (pose, rotation).
-            if (row == 0) return;
-            const int r = row - 1, s = t0 + col;
+          case DataBlock::kCoupling: {  // -V at (translation, rotation).
+            const int r = layout.reduced(row), s = t0 + col;
+            if (r < 0) return;
             abs_sum[r] += magnitude;
             ++count[r];
             abs_sum[s] += magnitude;

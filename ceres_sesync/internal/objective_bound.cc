@@ -10,9 +10,37 @@ constexpr double kU = std::numeric_limits<double>::epsilon() / 2;
 
 double Gamma(double k) { return k * kU / (1 - k * kU); }
 
+// Accumulates the squared residual entries r = x - y - sum_k A(p, k) z(k)
+// (y and A may be absent: null) into *value and their error bound into
+// *error (see ObjectiveUpperBound).
+struct ResidualBound {
+  int d;
+  double g;
+  double value = 0, error = 0;
+  void Add(double r, double magnitude) {
+    const double entry_error = g * magnitude;
+    value += r * r;
+    error += 2 * std::abs(r) * entry_error + 2 * entry_error * entry_error;
+  }
+  // x - y - A z (the translation residuals).
+  void Translation(const Eigen::VectorXd& x, const Eigen::VectorXd& y,
+                   const Eigen::MatrixXd& A, const Eigen::VectorXd& z) {
+    for (int p = 0; p < d; ++p) {
+      double r = x(p) - y(p);
+      double magnitude = std::abs(x(p)) + std::abs(y(p));
+      for (int k = 0; k < d; ++k) {
+        r -= A(p, k) * z(k);
+        magnitude += std::abs(A(p, k) * z(k));
+      }
+      Add(r, magnitude);
+    }
+  }
+};
+
 }  // namespace
 
-double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses) {
+double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
+                           const LandmarkPositions& landmarks) {
   const int d = graph.dimension;
   const double g = Gamma(d + 2);
   double f = 0, error = 0;
@@ -20,7 +48,7 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses) {
     const Pose& a = poses[e.i];
     const Pose& b = poses[e.j];
     // Rotation residual R_j - R_i R~: entries (p, q).
-    double rotation = 0, rotation_error = 0;
+    ResidualBound rotation{d, g};
     for (int p = 0; p < d; ++p) {
       for (int q = 0; q < d; ++q) {
         double r = b.R(p, q), magnitude = std::abs(b.R(p, q));
@@ -28,34 +56,63 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses) {
           r -= a.R(p, k) * e.R(k, q);
           magnitude += std::abs(a.R(p, k) * e.R(k, q));
         }
-        const double entry_error = g * magnitude;
-        rotation += r * r;
-        rotation_error +=
-            2 * std::abs(r) * entry_error + 2 * entry_error * entry_error;
+        rotation.Add(r, magnitude);
       }
     }
     // Translation residual t_j - t_i - R_i t~.
-    double translation = 0, translation_error = 0;
-    for (int p = 0; p < d; ++p) {
-      double r = b.t(p) - a.t(p);
-      double magnitude = std::abs(b.t(p)) + std::abs(a.t(p));
-      for (int k = 0; k < d; ++k) {
-        r -= a.R(p, k) * e.t(k);
-        magnitude += std::abs(a.R(p, k) * e.t(k));
-      }
-      const double entry_error = g * magnitude;
-      translation += r * r;
-      translation_error +=
-          2 * std::abs(r) * entry_error + 2 * entry_error * entry_error;
-    }
-    f += e.kappa * rotation + e.tau * translation;
-    error += e.kappa * rotation_error + e.tau * translation_error;
+    ResidualBound translation{d, g};
+    translation.Translation(b.t, a.t, a.R, e.t);
+    f += e.kappa * rotation.value + e.tau * translation.value;
+    error += e.kappa * rotation.error + e.tau * translation.error;
   }
-  // The sums (squares of entries, weights, edges) and this computation's
+  // Landmark residuals p_l - t_i - R_i z.
+  for (const LandmarkMeasurement& o : graph.landmark_measurements) {
+    const Pose& a = poses[o.i];
+    ResidualBound translation{d, g};
+    translation.Translation(landmarks[o.l], a.t, a.R, o.z);
+    f += o.nu * translation.value;
+    error += o.nu * translation.error;
+  }
+  // Prior residuals R_i - R~ and t_i - g.
+  for (const PosePrior& p : graph.priors) {
+    const Pose& a = poses[p.i];
+    if (p.has_rotation()) {
+      ResidualBound rotation{d, g};
+      for (int q = 0; q < d * d; ++q) {
+        rotation.Add(a.R(q) - p.R(q), std::abs(a.R(q)) + std::abs(p.R(q)));
+      }
+      f += p.kappa * rotation.value;
+      error += p.kappa * rotation.error;
+    }
+    if (p.has_position()) {
+      ResidualBound translation{d, g};
+      for (int q = 0; q < d; ++q) {
+        translation.Add(a.t(q) - p.t(q), std::abs(a.t(q)) + std::abs(p.t(q)));
+      }
+      f += p.tau * translation.value;
+      error += p.tau * translation.error;
+    }
+  }
+  // The sums (squares of entries, weights, terms) and this computation's
   // own rounding: gamma over all terms, relative to their (nonnegative)
   // values; the margin (1 + 1e-6) covers the rounding of the small terms.
-  const double terms = graph.measurements.size() * (2.0 * d * d + 4);
+  const double terms =
+      (graph.measurements.size() + graph.landmark_measurements.size() +
+       2.0 * graph.priors.size()) *
+      (2.0 * d * d + 4);
   return f + (2 * Gamma(terms) * (f + error) + error) * (1 + 1e-6);
+}
+
+double TotalPrecision(const PoseGraph& graph) {
+  double total = 0;
+  for (const RelativePoseMeasurement& e : graph.measurements) {
+    total += e.kappa + e.tau;
+  }
+  for (const LandmarkMeasurement& o : graph.landmark_measurements) {
+    total += o.nu;
+  }
+  for (const PosePrior& p : graph.priors) total += p.kappa + p.tau;
+  return total;
 }
 
 }  // namespace ceres_sesync::internal

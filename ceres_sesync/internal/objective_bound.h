@@ -1,7 +1,7 @@
-// A rigorous upper bound on the objective (12) at given poses, for the
-// suboptimality bounds of certificates: EvaluateObjective computes F in
-// double, and a certificate must not rest on an F that round-off made look
-// smaller than it is.
+// A rigorous upper bound on the objective (pose_graph.h: eq. 12 plus the
+// landmark and prior terms) at a given solution, for the suboptimality bounds
+// of certificates: EvaluateObjective computes F in double, and a certificate
+// must not rest on an F that round-off made look smaller than it is.
 
 #ifndef CERES_SESYNC_INTERNAL_OBJECTIVE_BOUND_H_
 #define CERES_SESYNC_INTERNAL_OBJECTIVE_BOUND_H_
@@ -10,15 +10,28 @@
 
 namespace ceres_sesync::internal {
 
-// F(poses) + a bound on |computed F - exact F| for EvaluateObjective's
-// arithmetic (standard model, u = 2^-53). Per residual entry
-// r = x_0 - sum_k a_k b_k (d <= 3 products), |fl(r) - r| <= e =
+// F(poses, landmarks) + a bound on |computed F - exact F| for
+// EvaluateObjective's arithmetic (standard model, u = 2^-53). Per residual
+// entry r = x_0 - sum_k a_k b_k (d <= 3 products), |fl(r) - r| <= e =
 // gamma_{d+1} (|x_0| + sum |a_k b_k|) + the inputs' own terms; its square
 // errs by at most 2|fl(r)| e + e^2 (+ the rounding of the square); the
 // weighted sums of m nonnegative terms err by at most gamma_{m+4} of their
 // value. Typically 1e-12 of F or less (more on large maps: the residuals
-// of translations far from the origin cancel more digits).
-double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses);
+// of translations far from the origin cancel more digits). Landmark
+// measurements are bounded like the translation residuals of edges, priors
+// like an edge from the identity pose. `landmarks` must hold one position
+// per landmark.
+double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
+                           const LandmarkPositions& landmarks = {});
+inline double ObjectiveUpperBound(const PoseGraph& graph,
+                                  const Solution& solution) {
+  return ObjectiveUpperBound(graph, solution.poses, solution.landmarks);
+}
+
+// The sum of every precision of the graph (kappa and tau of the edges, nu of
+// the landmark measurements, kappa and tau of the priors): the scale below
+// which an objective value is zero up to round-off.
+double TotalPrecision(const PoseGraph& graph);
 
 }  // namespace ceres_sesync::internal
 

@@ -27,7 +27,7 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
     }
   }
   const double eps = row_sums.maxCoeff() / max_condition;
-  const int d = d_, n = problem.num_poses();
+  const int d = d_, n = problem.num_rotations();
   if (type == PreconditionerType::kBlockJacobi) {
     block_inverses_.resize(d, d * n);
     const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(d, d);

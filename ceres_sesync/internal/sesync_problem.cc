@@ -205,23 +205,35 @@ void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
   common.print = 0;
 }
 
+ProblemLayout::ProblemLayout(const PoseGraph& graph)
+    : dimension(graph.dimension),
+      num_poses(graph.num_poses),
+      num_landmarks(graph.num_landmarks),
+      world_rotation(!graph.priors.empty()) {
+  for (const PosePrior& p : graph.priors) {
+    world_translation = world_translation || p.has_position();
+  }
+}
+
 SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
     : graph_(&graph),
+      layout_(graph),
       d_(graph.dimension),
-      n_(graph.num_poses),
+      n_(layout_.num_rotations()),
       num_threads_(std::max(1, num_threads)) {
-  const int d = d_, n = n_;
+  const int d = d_, n = n_, N = layout_.num_translations();
   std::vector<Triplet> lrho, sigma, v, lw;
-  const size_t m = graph.measurements.size();
+  const size_t m = graph.measurements.size() + graph.priors.size();
+  const size_t m_t = m + graph.landmark_measurements.size();
   lrho.reserve(m * (2 * d + 2 * d * d));
-  sigma.reserve(m * d * d);
-  v.reserve(2 * m * d);
-  lw.reserve(4 * m);
+  sigma.reserve(m_t * d * d);
+  v.reserve(2 * m_t * d);
+  lw.reserve(4 * m_t);
   // Per row of M: the sum of |terms| and their number, for the rounding
   // bounds. Rows of D carry the terms of L(G^rho) and Sigma~ plus one more
   // rounding (their sum).
-  std::vector<double> t_abs(n, 0.0), r_abs(d * n, 0.0);
-  std::vector<int> t_count(n, 0), r_count(d * n, 0);
+  std::vector<double> t_abs(N, 0.0), r_abs(d * n, 0.0);
+  std::vector<int> t_count(N, 0), r_count(d * n, 0);
   ForEachDataTerm<double>(
       graph, [&](DataBlock block, int row, int col, double value) {
         switch (block) {
@@ -257,8 +269,8 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
         (count + 3) * kUnitRoundoff / (1 - (count + 3) * kUnitRoundoff);
     return g * abs_sum * (1 + 1e-6);
   };
-  translation_row_rounding_.resize(n);
-  for (int i = 0; i < n; ++i)
+  translation_row_rounding_.resize(N);
+  for (int i = 0; i < N; ++i)
     translation_row_rounding_[i] = bound(t_count[i], t_abs[i]);
   rotation_row_rounding_.resize(d * n);
   for (int i = 0; i < d * n; ++i)
@@ -269,49 +281,71 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   sigma_matrix.setFromTriplets(sigma.begin(), sigma.end());
   D_ = Lrho_ + sigma_matrix;
 
-  // Drop vertex 0 (the gauge t_0 = 0) from the translational blocks.
+  // Drop the gauge node (t_0 = 0, or t_w = 0 with position priors) from the
+  // translational blocks.
+  const ProblemLayout& layout = layout_;
   std::vector<Triplet> vbar, lbar;
   for (const Triplet& t : v) {
-    if (t.row() > 0) vbar.emplace_back(t.row() - 1, t.col(), t.value());
+    const int row = layout.reduced(t.row());
+    if (row >= 0) vbar.emplace_back(row, t.col(), t.value());
   }
   for (const Triplet& t : lw) {
-    if (t.row() > 0 && t.col() > 0) {
-      lbar.emplace_back(t.row() - 1, t.col() - 1, t.value());
-    }
+    const int row = layout.reduced(t.row()), col = layout.reduced(t.col());
+    if (row >= 0 && col >= 0) lbar.emplace_back(row, col, t.value());
   }
-  Vbar_.resize(n - 1, d * n);
+  Vbar_.resize(N - 1, d * n);
   Vbar_.setFromTriplets(vbar.begin(), vbar.end());
   VbarT_ = Vbar_.transpose();
   minus_Vbar_ = -Vbar_;
   D_.makeCompressed();
   VbarT_.makeCompressed();
   minus_Vbar_.makeCompressed();
-  Lbar_.resize(n - 1, n - 1);
+  Lbar_.resize(N - 1, N - 1);
   Lbar_.setFromTriplets(lbar.begin(), lbar.end());
-  if (n == 1) {
+  const int num_vertices = layout.num_vertices();
+  if (num_vertices == 1) {
     vertex_ordering_ = {0};
     ok_ = true;
     return;
   }
-  // One fill-reducing ordering of the pose graph (on the pattern of
-  // L(W^tau)) serves Lbar here and the augmented matrices of
-  // certificate_matrix.h, whose (d+1)-blocks multiply its flops by about
-  // (d+1)^3 / 2. CHOLMOD's default choice (AMD here) is cheap; on large
-  // maps nested dissection (METIS) costs more to compute but leaves much
-  // less fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops
-  // (1.2x on city10000 and a 27,000-pose cube). So METIS is tried when the
-  // predicted flops of the augmented matrix exceed 2e4 per pose (about where
-  // its ~7 us per pose pays off), and kept if it predicts fewer flops.
+  // One fill-reducing ordering of the vertices (on the pattern of M
+  // collapsed to vertices: L(W^tau) for a pose graph) serves Lbar here and
+  // the augmented matrices of certificate_matrix.h, whose (d+1)-blocks
+  // multiply its flops by about (d+1)^3 / 2. CHOLMOD's default choice (AMD
+  // here) is cheap; on large maps nested dissection (METIS) costs more to
+  // compute but leaves much less fill: measured on a 50,000-pose 2D city
+  // walk, 2.5x fewer flops (1.2x on city10000 and a 27,000-pose cube). So METIS
+  // is tried when the predicted flops of the augmented matrix exceed 2e4 per
+  // pose (about where its ~7 us per pose pays off), and kept if it predicts
+  // fewer flops.
   {
-    SparseMatrix pattern(n, n);
-    pattern.setFromTriplets(lw.begin(), lw.end());
+    std::vector<Triplet> vertex_pattern = lw;
+    if (graph.has_landmarks_or_priors()) {
+      // Rotation-only priors (L(G^rho)) and the couplings of landmarks and
+      // position priors to their rotations (V) are not all in L(W^tau).
+      for (const Triplet& t : v) {
+        const int a = t.row(), b = layout.vertex_of_rotation(t.col() / d);
+        vertex_pattern.emplace_back(a, b, 1.0);
+        vertex_pattern.emplace_back(b, a, 1.0);
+      }
+      for (const Triplet& t : lrho) {
+        vertex_pattern.emplace_back(layout.vertex_of_rotation(t.row() / d),
+                                    layout.vertex_of_rotation(t.col() / d),
+                                    1.0);
+      }
+      for (int k = 0; k < num_vertices; ++k) {
+        vertex_pattern.emplace_back(k, k, 1.0);
+      }
+    }
+    SparseMatrix pattern(num_vertices, num_vertices);
+    pattern.setFromTriplets(vertex_pattern.begin(), vertex_pattern.end());
     CholmodFactor analysis;
     ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
     analysis.analyzePattern(pattern);
     vertex_ordering_ = analysis.Ordering();
     const double block_flops = std::pow(d + 1.0, 3) / 2;
     const double flops = analysis.cholmod().fl;
-    if (flops * block_flops > 2e4 * n) {
+    if (flops * block_flops > 2e4 * num_vertices) {
       CholmodFactor nested;
       ConfigureCholmod(CholmodLayout::kSimplicial, &nested);
       cholmod_common& common = nested.cholmod();
@@ -325,10 +359,17 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
               << nested.cholmod().fl;
     }
   }
+  if (N == 1) {  // Nothing to factorize (one pose, rotation priors only).
+    ok_ = true;
+    return;
+  }
   std::vector<int> lbar_ordering;
-  lbar_ordering.reserve(n - 1);
+  lbar_ordering.reserve(N - 1);
   for (int vertex : vertex_ordering_) {
-    if (vertex > 0) lbar_ordering.push_back(vertex - 1);
+    const int node = layout.translation_of_vertex(vertex);
+    if (node >= 0 && layout.reduced(node) >= 0) {
+      lbar_ordering.push_back(layout.reduced(node));
+    }
   }
   lbar_factor_ = std::make_unique<CholmodFactor>();
   ConfigureCholmod(CholmodLayout::kSimplicial, lbar_factor_.get());
@@ -343,7 +384,7 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
 void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,
                               Eigen::MatrixXd* YQ) const {
   MultiplyBySparse(Y, D_, /*accumulate=*/false, num_threads_, YQ);
-  if (n_ == 1) return;
+  if (Lbar_.rows() == 0) return;
   Eigen::MatrixXd P, Z;  // P = Y Vbar^T (r x (n-1)), Z = P Lbar^{-1}.
   MultiplyBySparse(Y, VbarT_, /*accumulate=*/false, num_threads_, &P);
   lbar_solver_.SolveRows(P, &Z, num_threads_);
@@ -351,9 +392,10 @@ void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,
 }
 
 double SESyncProblem::LbarBackwardError() const {
-  if (n_ == 1) return 0;
+  if (Lbar_.rows() == 0) return 0;
   double bound = 0, unused = 0;
-  lbar_factor_->BackwardErrorBound(n_ - 1, &bound, &unused);
+  lbar_factor_->BackwardErrorBound(static_cast<int>(Lbar_.rows()), &bound,
+                                   &unused);
   return bound;
 }
 
@@ -365,10 +407,14 @@ double BlockDiagonalTrace(const Eigen::MatrixXd& Lambda, int d) {
 
 Eigen::MatrixXd SESyncProblem::RecoverTranslations(
     const Eigen::MatrixXd& R) const {
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(d_, n_);
-  if (n_ == 1) return T;
-  const Eigen::MatrixXd rhs = Vbar_ * R.transpose();  // (n-1) x d
-  T.rightCols(n_ - 1) = lbar_factor_->solve(rhs).transpose();
+  const int N = layout_.num_translations();
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(d_, N);
+  if (N == 1) return T;
+  const Eigen::MatrixXd rhs = Vbar_ * R.transpose();  // (N-1) x d
+  const Eigen::MatrixXd reduced = lbar_factor_->solve(rhs).transpose();
+  for (int k = 0; k < N; ++k) {
+    if (layout_.reduced(k) >= 0) T.col(k) = reduced.col(layout_.reduced(k));
+  }
   return T;
 }
 

@@ -12,7 +12,18 @@
 // translations gives Q = D - Vbar^T Lbar^{-1} Vbar, where Lbar and Vbar drop
 // the first row (and column) of L(W^tau) and V. Q itself is dense; products
 // Y Q cost O(m r) through one sparse Cholesky factorization of Lbar (eq. 39).
-
+//
+// Landmarks and priors (pose_graph.h) keep this form; only the index sets
+// grow (ProblemLayout). A landmark is a translation node without a rotation:
+// its measurements are the translation halves of edges from their poses, so
+// L(W^tau) and V gain rows and Q stays a matrix of rotation blocks. A prior is
+// an edge from the world pose w = (I, 0), which becomes one more rotation
+// block (R_w) and, when some prior has a position term, one more translation
+// node (t_w). The extended objective is invariant under a global rigid
+// motion of all poses, landmarks and w, and equals F(x, p) at w = (I, 0), so
+// it has the same optimum; the solver solves it and expresses the answer in
+// w's frame (staircase.h). With t_w present, t_w is the eliminated gauge
+// node instead of t_0.
 #ifndef CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
 #define CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
 
@@ -80,19 +91,117 @@ constexpr double kSupernodalSwitch = 200;
 // printing (failures are reported through info()).
 void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor);
 
+// The index sets of the unknowns (see the top of this file):
+//   translation nodes  k = 0..n-1       pose translations t_k,
+//                      k = n..n+L-1     landmark positions p_(k-n),
+//                      k = n+L          t_w, iff world_translation;
+//   rotation blocks    k = 0..n-1       pose rotations R_k (rotation indices
+//                                       d*k .. d*k+d-1),
+//                      k = n            R_w, iff world_rotation.
+// world_rotation: the graph has priors; world_translation: a prior has a
+// position term (tau > 0; rotation-only priors leave t_w unused). The gauge
+// is the translation node fixed at 0 and eliminated from Lbar and Vbar: t_w
+// when it exists, else t_0. Vertices (for fill-reducing orderings) are the
+// translation nodes 0..n+L-1 plus, with priors, the world vertex n+L, which
+// carries R_w and t_w (if present): a vertex has a translation unless it is
+// the world without t_w, and a rotation unless it is a landmark.
+struct ProblemLayout {
+  ProblemLayout() = default;
+  explicit ProblemLayout(const PoseGraph& graph);
+
+  int dimension = 0, num_poses = 0, num_landmarks = 0;
+  bool world_rotation = false, world_translation = false;
+
+  int num_rotations() const { return num_poses + (world_rotation ? 1 : 0); }
+  int num_translations() const {
+    return num_poses + num_landmarks + (world_translation ? 1 : 0);
+  }
+  int num_vertices() const {
+    return num_poses + num_landmarks + (world_rotation ? 1 : 0);
+  }
+  int landmark_node(int l) const { return num_poses + l; }
+  // Valid iff world_translation / world_rotation.
+  int world_translation_node() const { return num_poses + num_landmarks; }
+  int world_rotation_block() const { return num_poses; }
+  // The translation node fixed at 0.
+  int gauge() const { return world_translation ? world_translation_node() : 0; }
+  // Index of translation node k in Lbar / Vbar (-1 for the gauge).
+  int reduced(int k) const {
+    const int g = gauge();
+    return k == g ? -1 : (k < g ? k : k - 1);
+  }
+  // The vertex of translation node k (its own index) and of rotation block k.
+  int vertex_of_rotation(int k) const {
+    return k < num_poses ? k : num_poses + num_landmarks;
+  }
+  // The translation node / rotation block of vertex v, or -1.
+  int translation_of_vertex(int v) const {
+    return v < num_poses + num_landmarks || world_translation ? v : -1;
+  }
+  int rotation_of_vertex(int v) const {
+    return v < num_poses ? v
+                         : (v == num_poses + num_landmarks ? num_poses : -1);
+  }
+};
+
 // The data matrix M of the objective as a sum of terms, one
 // visit(block, row, column, value) per term, with values computed in
 // `Scalar` from the measurements (double, or DoubleDouble for the
-// high-precision certificate). Blocks and their indices:
-//   kTranslation:   L(W^tau), poses (row, column);
-//   kCoupling:      V, pose row, rotation column d*i + a;
+// high-precision certificate). Blocks and their indices (ProblemLayout):
+//   kTranslation:   L(W^tau), translation nodes (row, column);
+//   kCoupling:      V, translation node row, rotation column d*k + a;
 //   kRotation:      L(G^rho), rotation indices;
 //   kRotationSigma: Sigma~, rotation indices (D = L(G^rho) + Sigma~).
 // The symmetric blocks get both (row, column) and (column, row) of every
 // off-diagonal term. Within a block, entries are the sums of their terms in
 // visiting order (so assembling from these terms reproduces SESyncProblem's
-// matrices bitwise).
+// matrices bitwise). The relative pose measurements come first, then the
+// landmark measurements (translation terms from pose i to node n + l with
+// t~ = z, tau = nu), then the priors (edges from w: rotation terms between
+// R_w and R_i with R~ if kappa > 0, translation terms from t_w to t_i with
+// t~ = g if tau > 0).
 enum class DataBlock { kTranslation, kCoupling, kRotation, kRotationSigma };
+
+namespace data_terms {
+
+// The translation half tau ||t_dst - t_src - R_src t~||^2 of an edge from
+// translation node `src` (rotation block `src_rotation`) to node `dst`.
+template <typename Scalar, typename Visit, typename Vector>
+void VisitTranslationTerm(int d, int src, int src_rotation, int dst,
+                          const Vector& t, double precision, Visit& visit) {
+  const Scalar tau(precision);
+  for (int a = 0; a < d; ++a) {
+    for (int b = 0; b < d; ++b) {
+      visit(DataBlock::kRotationSigma, d * src_rotation + a,
+            d * src_rotation + b, tau * Scalar(t(a)) * Scalar(t(b)));
+    }
+    const Scalar v = tau * Scalar(t(a));
+    visit(DataBlock::kCoupling, dst, d * src_rotation + a, v);
+    visit(DataBlock::kCoupling, src, d * src_rotation + a, -v);
+  }
+  visit(DataBlock::kTranslation, src, src, tau);
+  visit(DataBlock::kTranslation, dst, dst, tau);
+  visit(DataBlock::kTranslation, src, dst, -tau);
+  visit(DataBlock::kTranslation, dst, src, -tau);
+}
+
+// The rotation half kappa ||R_dst - R_src R~||_F^2 between rotation blocks.
+template <typename Scalar, typename Visit, typename Matrix>
+void VisitRotationTerm(int d, int src, int dst, const Matrix& R,
+                       double precision, Visit& visit) {
+  const Scalar kappa(precision);
+  for (int a = 0; a < d; ++a) {
+    visit(DataBlock::kRotation, d * src + a, d * src + a, kappa);
+    visit(DataBlock::kRotation, d * dst + a, d * dst + a, kappa);
+    for (int b = 0; b < d; ++b) {
+      const Scalar r = -kappa * Scalar(R(a, b));
+      visit(DataBlock::kRotation, d * src + a, d * dst + b, r);
+      visit(DataBlock::kRotation, d * dst + b, d * src + a, r);
+    }
+  }
+}
+
+}  // namespace data_terms
 
 template <typename Scalar, typename Visit>
 void ForEachDataTerm(const PoseGraph& graph, Visit&& visit) {
@@ -120,6 +229,24 @@ void ForEachDataTerm(const PoseGraph& graph, Visit&& visit) {
     visit(DataBlock::kTranslation, i, j, -tau);
     visit(DataBlock::kTranslation, j, i, -tau);
   }
+  // Landmark measurements: pose i -> translation node n + l.
+  const ProblemLayout layout(graph);
+  for (const LandmarkMeasurement& o : graph.landmark_measurements) {
+    data_terms::VisitTranslationTerm<Scalar>(
+        d, o.i, o.i, layout.landmark_node(o.l), o.z, o.nu, visit);
+  }
+  // Priors: edges from the world pose w to pose i.
+  for (const PosePrior& p : graph.priors) {
+    if (p.has_rotation()) {
+      data_terms::VisitRotationTerm<Scalar>(d, layout.world_rotation_block(),
+                                            p.i, p.R, p.kappa, visit);
+    }
+    if (p.has_position()) {
+      data_terms::VisitTranslationTerm<Scalar>(
+          d, layout.world_translation_node(), layout.world_rotation_block(),
+          p.i, p.t, p.tau, visit);
+    }
+  }
 }
 
 class SESyncProblem {
@@ -134,26 +261,35 @@ class SESyncProblem {
 
   bool ok() const { return ok_; }
   int dimension() const { return d_; }
-  int num_poses() const { return n_; }
+  // The index sets (ProblemLayout). Below, n is num_rotations() (the number
+  // of d x d blocks of Q: the poses, plus R_w with priors) and N is
+  // num_translations() (poses, landmarks, t_w); without landmarks and
+  // priors both are the number of poses.
+  const ProblemLayout& layout() const { return layout_; }
+  int num_rotations() const { return n_; }
+  int num_translations() const { return layout_.num_translations(); }
   int num_threads() const { return num_threads_; }
 
   // YQ = Y * Q for Y of size r x dn. O(m r) plus one Cholesky solve.
   void MultiplyQ(const Eigen::MatrixXd& Y, Eigen::MatrixXd* YQ) const;
 
-  // Optimal translations (d x n, eq. 21) for the rotations R (d x dn), with
-  // t_0 = 0.
+  // Optimal translations (d x N, eq. 21: every translation node, landmarks
+  // included) for the rotations R (d x dn), with the gauge node at 0.
   Eigen::MatrixXd RecoverTranslations(const Eigen::MatrixXd& R) const;
 
   // D = L(G^rho) + Sigma~ (dn x dn, both triangles stored).
   const SparseMatrix& D() const { return D_; }
-  // Vbar: V without its first row ((n-1) x dn).
+  // Vbar: V without the gauge node's row ((N-1) x dn, rows in
+  // ProblemLayout::reduced order).
   const SparseMatrix& Vbar() const { return Vbar_; }
-  // Lbar: L(W^tau) without its first row and column (both triangles stored).
+  // Lbar: L(W^tau) without the gauge node's row and column (both triangles
+  // stored).
   const SparseMatrix& Lbar() const { return Lbar_; }
   // The rotational connection Laplacian L(G^rho) alone (dn x dn).
   const SparseMatrix& RotationLaplacian() const { return Lrho_; }
-  // A fill-reducing ordering of the n poses (from the pattern of L(W^tau)):
-  // ordering[k] = pose eliminated k-th.
+  // A fill-reducing ordering of the vertices (ProblemLayout: poses,
+  // landmarks, the world) from the pattern of M collapsed to vertices:
+  // ordering[k] = vertex eliminated k-th.
   const std::vector<int>& vertex_ordering() const { return vertex_ordering_; }
   // A bound on the backward error of Lbar's Cholesky factorization
   // (CholmodFactor::BackwardErrorBound): the scale of the round-off that
@@ -165,7 +301,7 @@ class SESyncProblem {
   // values from the measurements (ForEachDataTerm), per row of
   // M = [L(W^tau) -V; -V^T D]: sum_j |stored M_ij - exact M_ij| over the row
   // (gamma_{k+1} times the sum of the row's |terms|, k its number of terms).
-  // Translation rows by pose (size n), rotation rows (size dn).
+  // Translation rows by translation node (size N), rotation rows (size dn).
   const std::vector<double>& translation_row_rounding() const {
     return translation_row_rounding_;
   }
@@ -175,6 +311,7 @@ class SESyncProblem {
 
  private:
   const PoseGraph* graph_ = nullptr;
+  ProblemLayout layout_;
   int d_ = 0, n_ = 0, num_threads_ = 1;
   std::vector<double> translation_row_rounding_, rotation_row_rounding_;
   bool ok_ = false;

@@ -48,24 +48,40 @@ RiemannianTrustRegionOptions TrustRegionOptions(const SolverOptions& options) {
 
 }  // namespace
 
-Poses ToPosesInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
-                     const Eigen::MatrixXd& T) {
+Solution ToSolutionInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
+                           const Eigen::MatrixXd& T) {
+  const ProblemLayout layout(graph);
   const int d = graph.dimension, n = graph.num_poses;
-  const int g = graph.fixed_pose >= 0 ? graph.fixed_pose : 0;
-  Eigen::MatrixXd RG = Eigen::MatrixXd::Identity(d, d);
-  Eigen::VectorXd tG = Eigen::VectorXd::Zero(d);
-  if (!graph.initial_poses.empty()) {
-    RG = graph.initial_poses[g].R;
-    tG = graph.initial_poses[g].t;
+  // x' = A (x - c) + b for every position, R' = A R for every rotation.
+  Eigen::MatrixXd A;
+  Eigen::VectorXd c, b = Eigen::VectorXd::Zero(d);
+  if (layout.world_rotation) {
+    A = R.middleCols(d * layout.world_rotation_block(), d).transpose();
   }
-  const Eigen::MatrixXd A = RG * R.middleCols(d * g, d).transpose();
-  const Eigen::VectorXd tg = T.col(g);
-  Poses poses(n);
+  if (layout.world_translation) {
+    c = T.col(layout.world_translation_node());
+  } else {
+    // The FIX pose (else pose 0) at its initial value, else at the identity.
+    const int g = graph.fixed_pose >= 0 ? graph.fixed_pose : 0;
+    Eigen::MatrixXd RG = Eigen::MatrixXd::Identity(d, d);
+    if (!graph.initial_poses.empty()) {
+      RG = graph.initial_poses[g].R;
+      b = graph.initial_poses[g].t;
+    }
+    if (!layout.world_rotation) A = RG * R.middleCols(d * g, d).transpose();
+    c = T.col(g);
+  }
+  Solution x;
+  x.poses.resize(n);
   for (int i = 0; i < n; ++i) {
-    poses[i].R = ProjectToRotation(A * R.middleCols(d * i, d));
-    poses[i].t = A * (T.col(i) - tg) + tG;
+    x.poses[i].R = ProjectToRotation(A * R.middleCols(d * i, d));
+    x.poses[i].t = A * (T.col(i) - c) + b;
   }
-  return poses;
+  x.landmarks.resize(graph.num_landmarks);
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    x.landmarks[l] = A * (T.col(layout.landmark_node(l)) - c) + b;
+  }
+  return x;
 }
 
 Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
@@ -77,19 +93,25 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   s.dimension = graph.dimension;
   s.num_poses = graph.num_poses;
   s.num_measurements = static_cast<int>(graph.measurements.size());
+  s.num_landmarks = graph.num_landmarks;
+  s.num_landmark_measurements =
+      static_cast<int>(graph.landmark_measurements.size());
+  s.num_priors = static_cast<int>(graph.priors.size());
   if (!ValidatePoseGraph(graph, &s.message)) {
     s.status = SolverSummary::Status::kInvalidInput;
     return;
   }
+  const ProblemLayout layout(graph);
   d_ = graph.dimension;
-  n_ = graph.num_poses;
+  n_ = layout.num_rotations();
   r0_ = options.initial_rank > 0 ? options.initial_rank : d_ + 2;
   if (r0_ < d_ + 1 || options.max_rank < r0_) {
     s.status = SolverSummary::Status::kInvalidInput;
     s.message = "initial_rank must be >= d + 1 and <= max_rank";
     return;
   }
-  if (n_ == 1) {  // Nothing to estimate: the pose is the gauge.
+  if (n_ == 1 && layout.num_translations() == 1) {
+    // Nothing to estimate: the pose is the gauge.
     s.status = SolverSummary::Status::kCertifiedOptimum;
     s.relaxation_exact = true;
     s.final_rank = d_;
@@ -114,12 +136,8 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
   scale_ = MaxDiagonal(problem_->D());
   // Objective values below this are zero up to round-off (F is a sum of
-  // squares weighted by kappa and tau).
-  double total_weight = 0;
-  for (const RelativePoseMeasurement& e : graph.measurements) {
-    total_weight += e.kappa + e.tau;
-  }
-  zero_objective_ = 1e-12 * total_weight;
+  // squares weighted by the precisions).
+  zero_objective_ = 1e-12 * TotalPrecision(graph);
   s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
   ok_ = true;
 }
@@ -155,9 +173,9 @@ double Staircase::RemainingTime() const {
              : 0;
 }
 
-Poses Staircase::Trivial() const {
-  return ToPosesInGauge(graph_, Eigen::MatrixXd::Identity(d_, d_),
-                        Eigen::MatrixXd::Zero(d_, 1));
+Solution Staircase::Trivial() const {
+  return ToSolutionInGauge(graph_, Eigen::MatrixXd::Identity(d_, d_),
+                           Eigen::MatrixXd::Zero(d_, 1));
 }
 
 bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
@@ -166,8 +184,10 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
   const auto t = Clock::now();
   const int d = d_, n = n_;
   Y->setZero(r0_, d * n);
+  // With priors, given rotations are in the world frame: R_w = I.
+  Y->topRows(d).rightCols(d * (n - graph_.num_poses)).setIdentity();
   if (initial) {
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < graph_.num_poses; ++i) {
       Y->block(0, d * i, d, d) = ProjectToRotation((*initial)[i].R);
     }
   } else if (options_.initialization ==
@@ -179,7 +199,7 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
           "no initial poses";
       return false;
     }
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < graph_.num_poses; ++i) {
       Y->block(0, d * i, d, d) = graph_.initial_poses[i].R;
     }
   } else if (options_.initialization ==
@@ -188,7 +208,7 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
     *Y = RandomStiefelProductPoint(d, r0_, n, &rng);
   } else {
     Eigen::MatrixXd R;
-    if (!ChordalRotationsFromLaplacian(problem_->RotationLaplacian(), d, &R)) {
+    if (!ChordalRotations(*problem_, &R)) {
       s.status = SolverSummary::Status::kInvalidInput;
       s.message = "chordal initialization failed";
       return false;
@@ -257,10 +277,11 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
 
 namespace {
 
-// max_a sum_i (t_i(a) - t_0(a))^2 / n for translations T (d x n).
-double TranslationSpread(const Eigen::MatrixXd& T) {
-  const Eigen::MatrixXd centered = T.colwise() - T.col(0);
-  return centered.rowwise().squaredNorm().maxCoeff() / T.cols();
+// max_a sum_k (t_k(a) - t_g(a))^2 / n over the translation nodes k of T
+// (d x N, gauge node g), n rotation blocks (see VerificationOptions).
+double TranslationSpread(const Eigen::MatrixXd& T, int gauge, int n) {
+  const Eigen::MatrixXd centered = T.colwise() - T.col(gauge);
+  return centered.rowwise().squaredNorm().maxCoeff() / n;
 }
 
 ProofPolicy ToPolicy(SolverOptions::ProofArithmetic arithmetic) {
@@ -311,8 +332,8 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
       extended_deferred_ = true;
     }
   }
-  verification_options.translation_spread =
-      TranslationSpread(problem_->RecoverTranslations(R));
+  verification_options.translation_spread = TranslationSpread(
+      problem_->RecoverTranslations(R), problem_->layout().gauge(), n);
   VerificationResult verification = VerifyCertificate(
       *problem_, cost_->Lambda(), verification_options, certificate_.get());
   if (!verification.certified && sdp_value <= zero_objective_) {
@@ -422,7 +443,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
   }
 }
 
-Poses Staircase::Round(const Eigen::MatrixXd& Y) {
+Solution Staircase::Round(const Eigen::MatrixXd& Y) {
   SolverSummary& s = *summary_;
   Progress("round", static_cast<int>(Y.rows()));
   const auto t = Clock::now();
@@ -445,9 +466,9 @@ Poses Staircase::Round(const Eigen::MatrixXd& Y) {
     }
   }
   const Eigen::MatrixXd T = problem_->RecoverTranslations(R);
-  Poses poses = ToPosesInGauge(graph_, R, T);
+  Solution solution = ToSolutionInGauge(graph_, R, T);
   s.rounding_time_s = std::chrono::duration<double>(Clock::now() - t).count();
-  return poses;
+  return solution;
 }
 
 void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
@@ -482,9 +503,9 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
   }
 }
 
-void Staircase::Report(const Eigen::MatrixXd& Y, const Poses& poses) {
+void Staircase::Report(const Eigen::MatrixXd& Y, const Solution& solution) {
   SolverSummary& s = *summary_;
-  s.objective = EvaluateObjective(graph_, poses);
+  s.objective = EvaluateObjective(graph_, solution);
   if (extended_deferred_ && verification_.certified) {
     TightenProof(Y, s.objective);
   }
@@ -502,7 +523,7 @@ void Staircase::Report(const Eigen::MatrixXd& Y, const Poses& poses) {
   s.lower_bound = std::min(s.lower_bound, s.objective);
   // F(x) rounded up: the bound must not rest on round-off in F.
   s.suboptimality_bound =
-      std::max(0.0, ObjectiveUpperBound(graph_, poses) - s.lower_bound);
+      std::max(0.0, ObjectiveUpperBound(graph_, solution) - s.lower_bound);
   // A numerically zero F is optimal by F >= 0 (no ratio to a zero bound).
   s.relative_suboptimality_bound =
       s.objective <= zero_objective_ ? 0

@@ -12,9 +12,14 @@
 //   if (!staircase.Initialize(initial, &Y)) return {};
 //   staircase.Run(&Y);                               // optimize / verify /
 //                                                    // escape, level by level
-//   Poses poses = staircase.Round(Y);                // Algorithm 2 + eq. (21)
-//   staircase.Report(poses);                         // objective, bounds,
-//   status
+//   Solution x = staircase.Round(Y);                 // Algorithm 2 + eq. (21)
+//   staircase.Report(Y, x);                          // objective, bounds,
+//                                                    // status
+//
+// Graphs with landmarks and priors run the same stages on the extended
+// problem of sesync_problem.h (landmarks among the eliminated translations,
+// priors as edges from a world pose); Round() expresses the answer in the
+// world frame.
 //
 // Every stage records what it did in the SolverSummary given at
 // construction (times, levels, counts).
@@ -48,17 +53,18 @@ class Staircase {
   ~Staircase();
 
   // False if validation or the data matrices failed (summary has the status
-  // and message), or the problem is trivial (n = 1: Trivial() holds the
-  // answer).
+  // and message).
   bool ok() const { return ok_; }
-  // n == 1 with a valid graph: the single pose is the gauge; the summary is
-  // complete and Trivial() returns the poses.
+  // A single pose without landmarks and priors: it is the gauge; the
+  // summary is complete and Trivial() returns the solution.
   bool trivial() const { return trivial_; }
-  Poses Trivial() const;
+  Solution Trivial() const;
 
-  // Stage "initialize": Y (r0 x dn) from `initial` (its rotations projected
-  // to SO(d)) or, if null, from options.initialization. False (summary has
-  // the status) if the requested initialization is unavailable.
+  // Stage "initialize": Y (r0 x dn, n = problem().num_rotations()) from
+  // `initial` (its rotations projected to SO(d); with priors they are in the
+  // world frame, and R_w starts at I) or, if null, from
+  // options.initialization. False (summary has the status) if the requested
+  // initialization is unavailable.
   bool Initialize(const Poses* initial, Eigen::MatrixXd* Y);
 
   // Stage "staircase": from Y (any rank >= d + 1), optimize, verify, and
@@ -73,15 +79,16 @@ class Staircase {
   VerificationResult Verify(const Eigen::MatrixXd& Y, double sdp_value);
 
   // Stage "round": Algorithm 2 on Y, the optional refinement on SO(d)^n, the
-  // optimal translations (eq. 21), in the documented gauge.
-  Poses Round(const Eigen::MatrixXd& Y);
+  // optimal translations and landmark positions (eq. 21), in the documented
+  // gauge (ToSolutionInGauge).
+  Solution Round(const Eigen::MatrixXd& Y);
 
   // Stage "report": objective, lower bound, suboptimality bounds, rounding
-  // gap, final status and total time for the returned `poses` (rounded from
-  // Y). When the relaxation proved not exact and double precision left the
-  // poses' bound above the tolerance, the proof is tightened in
+  // gap, final status and total time for the returned `solution` (rounded
+  // from Y). When the relaxation proved not exact and double precision left
+  // the solution's bound above the tolerance, the proof is tightened in
   // double-double first (the only case Verify() defers it).
-  void Report(const Eigen::MatrixXd& Y, const Poses& poses);
+  void Report(const Eigen::MatrixXd& Y, const Solution& solution);
 
   const SESyncProblem& problem() const { return *problem_; }
   SESyncCost& cost() { return *cost_; }
@@ -127,11 +134,15 @@ class Staircase {
   bool extended_deferred_ = false;
 };
 
-// Poses from rotations R (d x dn) and translations T (d x n), expressed in the
-// documented gauge: the FIX pose (else pose 0) sits at its initial value (else
+// The solution from rotations R (d x dn) and translations T (d x N) in the
+// index sets of ProblemLayout, expressed in the documented gauge. With priors:
+// in the world frame, i.e. every pose and landmark moved by the rigid motion
+// that takes the world pose (R_w, t_w) to (I, 0) (with rotation-only priors
+// t_w does not exist: the translations are then placed as without priors).
+// Without priors: the FIX pose (else pose 0) sits at its initial value (else
 // at the identity).
-Poses ToPosesInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
-                     const Eigen::MatrixXd& T);
+Solution ToSolutionInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
+                           const Eigen::MatrixXd& T);
 
 }  // namespace ceres_sesync::internal
 

@@ -39,7 +39,7 @@ class CertificateOperator {
                       const Eigen::MatrixXd* Lambda)
       : problem_(problem), lambda_(Lambda) {}
   Eigen::Index rows() const {
-    return problem_->dimension() * problem_->num_poses();
+    return problem_->dimension() * problem_->num_rotations();
   }
   Eigen::Index cols() const { return rows(); }
   void perform_op(const double* x_in, double* y_out) const {

@@ -120,9 +120,7 @@ void CheckResult(const ReadResult& r) {
   }
   const PoseGraph& g = r.graph;
   std::string error;
-  ceres_sesync::ValidationOptions validation;
-  validation.allow_landmarks_and_priors = true;
-  FUZZ_CHECK(ceres_sesync::ValidatePoseGraph(g, validation, &error), error);
+  FUZZ_CHECK(ceres_sesync::ValidatePoseGraph(g, &error), error);
   FUZZ_CHECK(!g.measurements.empty() || !g.landmark_measurements.empty() ||
                  !g.priors.empty(),
              "");

@@ -272,6 +272,67 @@ Eigen::MatrixXd StackLandmarkSolution(const PoseGraph& graph,
   return X;
 }
 
+DenseLandmarkProblem BuildDenseLandmarkProblem(const PoseGraph& graph) {
+  const int d = graph.dimension, n = graph.num_poses, L = graph.num_landmarks;
+  const int tw = n + L;  // Column of t_w in DenseLandmarkDataMatrix.
+  bool position_prior = false;
+  for (const PosePrior& p : graph.priors) position_prior |= p.tau > 0;
+  DenseLandmarkProblem out;
+  for (int k = 0; k < n + L; ++k) out.translation_columns.push_back(k);
+  if (position_prior) out.translation_columns.push_back(tw);
+  for (int i = 0; i < n; ++i) out.rotation_columns.push_back(tw + 1 + d * i);
+  if (!graph.priors.empty()) out.rotation_columns.push_back(tw + 1 + d * n);
+  out.gauge_column = position_prior ? tw : 0;
+  std::vector<int> reduced;
+  for (int c : out.translation_columns) {
+    if (c != out.gauge_column) reduced.push_back(c);
+  }
+  std::vector<int> rotations;
+  for (int c : out.rotation_columns) {
+    for (int a = 0; a < d; ++a) rotations.push_back(c + a);
+  }
+  const Eigen::MatrixXd M = DenseLandmarkDataMatrix(graph);
+  const int t = static_cast<int>(reduced.size());
+  const int r = static_cast<int>(rotations.size());
+  out.Lbar.resize(t, t);
+  out.Vbar.resize(t, r);
+  out.D.resize(r, r);
+  for (int a = 0; a < t; ++a) {
+    for (int b = 0; b < t; ++b) out.Lbar(a, b) = M(reduced[a], reduced[b]);
+    for (int b = 0; b < r; ++b) out.Vbar(a, b) = -M(reduced[a], rotations[b]);
+  }
+  for (int a = 0; a < r; ++a) {
+    for (int b = 0; b < r; ++b) out.D(a, b) = M(rotations[a], rotations[b]);
+  }
+  out.Q = out.D;
+  if (t > 0) out.Q -= out.Vbar.transpose() * out.Lbar.llt().solve(out.Vbar);
+  out.Q = 0.5 * (out.Q + out.Q.transpose());
+  return out;
+}
+
+Eigen::MatrixXd DenseLandmarkQ(const PoseGraph& graph) {
+  const int d = graph.dimension, n = graph.num_poses, L = graph.num_landmarks;
+  const Eigen::MatrixXd M = DenseLandmarkDataMatrix(graph);
+  const int t = n + L + 1, r = d * (graph.priors.empty() ? n : n + 1);
+  const Eigen::MatrixXd Mtt = M.topLeftCorner(t, t);
+  const Eigen::MatrixXd Mtr = M.block(t, 0, r, t).transpose();
+  const Eigen::MatrixXd Mrr = M.block(t, t, r, r);
+  const Eigen::MatrixXd pinv =
+      Mtt.completeOrthogonalDecomposition().pseudoInverse();
+  Eigen::MatrixXd Q = Mrr - Mtr.transpose() * pinv * Mtr;
+  return 0.5 * (Q + Q.transpose());
+}
+
+Eigen::MatrixXd StackSolverRotations(const PoseGraph& graph,
+                                     const Poses& poses) {
+  const int d = graph.dimension, n = graph.num_poses;
+  const int blocks = graph.priors.empty() ? n : n + 1;
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(d, d * blocks);
+  for (int i = 0; i < n; ++i) R.middleCols(d * i, d) = poses[i].R;
+  if (blocks > n) R.rightCols(d).setIdentity();
+  return R;
+}
+
 Eigen::MatrixXd DenseQ(const PoseGraph& graph) {
   const int d = graph.dimension, n = graph.num_poses;
   const Eigen::MatrixXd M = DenseDataMatrix(graph);

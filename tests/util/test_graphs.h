@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <random>
+#include <vector>
 
 #include "Eigen/Core"
 #include "ceres_sesync/pose_graph.h"
@@ -117,6 +118,33 @@ Eigen::MatrixXd DenseLandmarkDataMatrix(const PoseGraph& graph);
 // X = [T P t_w | R R_w] of DenseLandmarkDataMatrix for a solution.
 Eigen::MatrixXd StackLandmarkSolution(const PoseGraph& graph,
                                       const Solution& solution);
+
+// DenseLandmarkDataMatrix in the solver's index sets (documented in
+// ceres_sesync/internal/sesync_problem.h, ProblemLayout): translation nodes
+// [t_1 .. t_n, p_1 .. p_L, t_w if some prior has a position term], rotation
+// blocks [R_1 .. R_n, R_w if the graph has priors], and the gauge node (t_w
+// if present, else t_1) dropped. With M = [L -V; -V^T D] on those sets:
+// Lbar, Vbar (the reduced translation rows; Vbar = -M_TR), D = M_RR, and
+// Q = D - Vbar^T Lbar^-1 Vbar by a dense Cholesky solve. A second route to Q
+// besides DenseLandmarkQ. Also: which columns of X (StackLandmarkSolution)
+// the sets select.
+struct DenseLandmarkProblem {
+  Eigen::MatrixXd Lbar, Vbar, D, Q;
+  std::vector<int> translation_columns;  // Columns of X, in node order.
+  std::vector<int> rotation_columns;     // First column of each block.
+  int gauge_column = 0;
+};
+DenseLandmarkProblem BuildDenseLandmarkProblem(const PoseGraph& graph);
+
+// Q of a graph with landmarks and priors as the Schur complement of the
+// translation block of DenseLandmarkDataMatrix through its pseudo-inverse,
+// restricted to the rotation blocks of the solver (R_w only with priors).
+Eigen::MatrixXd DenseLandmarkQ(const PoseGraph& graph);
+
+// The rotations R (d x dn) of a solution in the solver's rotation blocks:
+// the poses', then R_w = I if the graph has priors.
+Eigen::MatrixXd StackSolverRotations(const PoseGraph& graph,
+                                     const Poses& poses);
 
 // Dense Q (dn x dn): the Schur complement of the translation block of M,
 // Q = M_RR - M_RT pinv(M_TT) M_TR (pinv: the Laplacian M_TT of a connected
