@@ -58,14 +58,10 @@
 // stdout and to
 // --out when given.
 
-// Build note: the internal headers include CHOLMOD's cholmod.h, whose
-// directory (/usr/include/suitesparse on Debian) the bench targets do not get
-// from bench/CMakeLists.txt (ceres_sesync links SuiteSparse::CHOLMOD
-// privately). Until that file links SuiteSparse::CHOLMOD as
-// tests/CMakeLists.txt does, build with the directory on the include path,
-// e.g. CPATH=/usr/include/suitesparse cmake --build BUILD --target
-// formulation_compare; without it this program compiles to a stub that says
-// so (and the other benchmarks still build).
+// Build note: the internal headers include CHOLMOD's cholmod.h;
+// bench/CMakeLists.txt links SuiteSparse::CHOLMOD (and so gets its include
+// directory) for every bench program. Without it this program would compile
+// to a stub that says so.
 
 #if !__has_include(<cholmod.h>)
 
@@ -271,8 +267,7 @@ bool BuildExplicitData(const internal::SESyncProblem& problem, double eps,
     // that both forms apply the very same factor (SolveRows here,
     // SolveRowsTail in the implicit form).
     internal::CertificateMatrix certificate(problem);
-    if (!certificate.Factorize(Eigen::MatrixXd::Zero(d, d * n), eps,
-                               /*bound_backward_error=*/false)) {
+    if (!certificate.Factorize(Eigen::MatrixXd::Zero(d, d * n), eps)) {
       return false;
     }
     data->preconditioner = certificate.ExtractFactor();

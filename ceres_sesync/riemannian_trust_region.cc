@@ -118,6 +118,7 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
   Eigen::MatrixXd g, pg, x_new;
   double radius = options.initial_trust_radius;
   double reference_norm = 1, initial_radius = 1;
+  bool switched = false;  // The preconditioner changed (UpdatePreconditioner).
   auto finish = [&](Termination t) {
     summary->termination = t;
     summary->final_cost = f;
@@ -127,7 +128,15 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
     cost->Gradient(&g);
     cost->Precondition(g, &pg);
     const double g_norm = std::sqrt(Inner(g, g));
-    const double pg_norm = std::sqrt(std::max(0.0, Inner(g, pg)));
+    double pg_norm = std::sqrt(std::max(0.0, Inner(g, pg)));
+    // An adaptive preconditioner may change when the test is met: the test
+    // that stops the solve is the final preconditioner's.
+    while (pg_norm <= options.preconditioned_gradient_tolerance &&
+           cost->UpdatePreconditioner(0, /*converged=*/true)) {
+      cost->Precondition(g, &pg);
+      pg_norm = std::sqrt(std::max(0.0, Inner(g, pg)));
+      switched = true;
+    }
     summary->final_gradient_norm = g_norm;
     summary->final_preconditioned_gradient_norm = pg_norm;
     if (!std::isfinite(f) || !std::isfinite(g_norm)) {
@@ -144,10 +153,13 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
       return finish(Termination::kMaxTime);
     }
     if (k == 0) reference_norm = g_norm;
-    if (radius <= 0) {
+    if (radius <= 0 || switched) {
       // Initial radius: the length (in the P^{-1} norm) of the preconditioned
-      // steepest-descent step -P g, a scale-free choice.
+      // steepest-descent step -P g, a scale-free choice; again after the
+      // preconditioner changed (the radius is in its norm).
       radius = pg_norm;
+      if (switched) initial_radius = radius;
+      switched = false;
     }
     if (k == 0) initial_radius = radius;
     // Inner solve, then shrink the radius until a step is accepted.
@@ -157,6 +169,8 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
             return options.max_time_s > 0 && elapsed() >= options.max_time_s;
           });
       summary->hessian_vector_products += step.iterations;
+      switched |=
+          cost->UpdatePreconditioner(step.iterations, /*converged=*/false);
       const double model_decrease =
           -(Inner(g, step.eta) + 0.5 * Inner(step.eta, step.h_eta));
       cost->Retract(*x, step.eta, &x_new);
@@ -188,8 +202,11 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
           summary->final_gradient_norm = std::sqrt(Inner(g, g));
           return finish(Termination::kUserCallback);
         }
-        if (decrease <= options.relative_decrease_tolerance * std::abs(f) ||
-            step_norm <= options.step_tolerance) {
+        // A convergence test met under a preconditioner that then changes
+        // goes on in the new one (see UpdatePreconditioner).
+        if ((decrease <= options.relative_decrease_tolerance * std::abs(f) ||
+             step_norm <= options.step_tolerance) &&
+            !(switched = cost->UpdatePreconditioner(0, /*converged=*/true))) {
           cost->Gradient(&g);
           cost->Precondition(g, &pg);
           summary->final_gradient_norm = std::sqrt(Inner(g, g));
@@ -204,13 +221,19 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
       }
       // Rejected: restore the current point in the cost function.
       cost->Evaluate(*x);
-      if (step_norm <= options.step_tolerance ||
-          radius <= 1e-12 * initial_radius) {
+      if ((step_norm <= options.step_tolerance ||
+           radius <= 1e-12 * initial_radius) &&
+          !cost->UpdatePreconditioner(0, /*converged=*/true)) {
         summary->iterations = k + 1;
         return finish(Termination::kStepTolerance);
       }
       if (options.max_time_s > 0 && elapsed() >= options.max_time_s) {
         return finish(Termination::kMaxTime);
+      }
+      if (switched) {  // The radius restarts in the new norm.
+        cost->Precondition(g, &pg);
+        radius = initial_radius = std::sqrt(std::max(0.0, Inner(g, pg)));
+        switched = false;
       }
     }
   }

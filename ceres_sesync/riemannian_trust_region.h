@@ -35,6 +35,19 @@ class RiemannianCostFunction {
   // Retraction: the point reached from x along the tangent vector v.
   virtual void Retract(const Eigen::MatrixXd& x, const Eigen::MatrixXd& v,
                        Eigen::MatrixXd* result) = 0;
+  // Adaptive preconditioning: called after every truncated-CG solve with its
+  // number of inner iterations (converged = false), and whenever a
+  // convergence test is met (converged = true: the preconditioned gradient,
+  // relative decrease or step test). Returns true iff Precondition()
+  // applies a different preconditioner from now on; the solver then goes on
+  // in the new one instead of stopping, so that a solve always stops on its
+  // final preconditioner's tests, and restarts the trust radius in its norm
+  // (as at the start). The default keeps the preconditioner.
+  virtual bool UpdatePreconditioner(int inner_iterations, bool converged) {
+    (void)inner_iterations;
+    (void)converged;
+    return false;
+  }
   // Orthogonal projection of v onto the tangent space at the current point
   // (used to suppress round-off drift in the inner solver). Must allow
   // result == &v (the inner solver projects in place).
@@ -50,7 +63,8 @@ struct RiemannianTrustRegionOptions {
   // Stop when ||grad f|| <= gradient_tolerance.
   double gradient_tolerance = 1e-6;
   // Stop when sqrt(<grad f, P grad f>) <= preconditioned_gradient_tolerance
-  // (P the preconditioner).
+  // (P the preconditioner, in its final form if it adapts: see
+  // RiemannianCostFunction::UpdatePreconditioner).
   double preconditioned_gradient_tolerance = 1e-6;
   // Stop when an accepted step decreases f by less than this fraction of |f|.
   double relative_decrease_tolerance = 1e-12;

@@ -10,13 +10,15 @@
 
 namespace ceres_sesync::internal {
 
-SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
-                                           PreconditionerType type,
-                                           double max_condition,
-                                           CertificateMatrix* workspace)
-    : d_(problem.dimension()),
+SESyncPreconditioner::SESyncPreconditioner(
+    const SESyncProblem& problem, PreconditionerType type, double max_condition,
+    CertificateMatrix* workspace, const PreconditionerSettings& settings)
+    : problem_(problem),
+      d_(problem.dimension()),
       num_threads_(problem.num_threads()),
-      type_(type) {
+      type_(type),
+      settings_(settings),
+      workspace_(workspace) {
   if (type == PreconditionerType::kNone) return;
   const SparseMatrix& D = problem.D();
   // Gershgorin bound on lambda_max(D).
@@ -26,9 +28,11 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
       row_sums(it.row()) += std::abs(it.value());
     }
   }
-  const double eps = row_sums.maxCoeff() / max_condition;
+  eps_ = row_sums.maxCoeff() / max_condition;
+  const double eps = eps_;
   const int d = d_, n = problem.num_rotations();
-  if (type == PreconditionerType::kBlockJacobi) {
+  if (type == PreconditionerType::kBlockJacobi ||
+      type == PreconditionerType::kAdaptive) {
     block_inverses_.resize(d, d * n);
     const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(d, d);
     for (int i = 0; i < n; ++i) {
@@ -39,15 +43,7 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
     return;
   }
   if (type == PreconditionerType::kRegularizedQ) {
-    std::unique_ptr<CertificateMatrix> own;
-    if (workspace == nullptr) {
-      own = std::make_unique<CertificateMatrix>(problem);
-      workspace = own.get();
-    }
-    CHECK(workspace->Factorize(Eigen::MatrixXd::Zero(d, d * n), eps))
-        << "regularized Q preconditioner: factorization failed";
-    factor_ = workspace->ExtractFactor();
-    translation_size_ = workspace->translation_size();
+    FactorizeRegularizedQ();
     return;
   }
   SparseMatrix regularized = D;
@@ -60,6 +56,40 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
   CHECK(factor.info() == Eigen::Success)
       << "regularized Cholesky preconditioner failed";
   factor_ = factor.ExtractFactor();
+  if (settings_.precision == FactorPrecision::kSingle) {
+    factor_.ConvertToSinglePrecision();
+  }
+}
+
+SESyncPreconditioner::~SESyncPreconditioner() = default;
+
+void SESyncPreconditioner::FactorizeRegularizedQ() {
+  CertificateMatrix* workspace = workspace_;
+  if (workspace == nullptr) {
+    own_workspace_ = std::make_unique<CertificateMatrix>(problem_);
+    workspace = own_workspace_.get();
+  }
+  const int dn = d_ * problem_.num_rotations();
+  CHECK(workspace->Factorize(Eigen::MatrixXd::Zero(d_, dn), eps_))
+      << "regularized Q preconditioner: factorization failed";
+  factor_ = workspace->ExtractFactor();
+  if (settings_.precision == FactorPrecision::kSingle) {
+    factor_.ConvertToSinglePrecision();
+  }
+  translation_size_ = workspace->translation_size();
+  own_workspace_.reset();  // Only its factor was needed.
+  exact_ = true;
+}
+
+bool SESyncPreconditioner::Update(int inner_iterations, bool converged) {
+  if (type_ != PreconditionerType::kAdaptive || exact_) return false;
+  if (!converged && inner_iterations <= settings_.switch_iterations) {
+    return false;
+  }
+  FactorizeRegularizedQ();
+  block_inverses_.resize(0, 0);
+  ++switches_;
+  return true;
 }
 
 void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
@@ -77,11 +107,18 @@ void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
     case PreconditionerType::kRegularizedQ:
       factor_.SolveRowsTail(V, translation_size_, X, num_threads_);
       return;
+    case PreconditionerType::kAdaptive:
+      if (exact_) {
+        factor_.SolveRowsTail(V, translation_size_, X, num_threads_);
+      } else {
+        BlockDiagonalMultiply(V, block_inverses_, d_, X);
+      }
+      return;
   }
 }
 
 SESyncCost::SESyncCost(const SESyncProblem* problem,
-                       const SESyncPreconditioner* preconditioner)
+                       SESyncPreconditioner* preconditioner)
     : problem_(problem),
       preconditioner_(preconditioner),
       d_(problem->dimension()) {}
@@ -111,6 +148,10 @@ void SESyncCost::HessianVector(const Eigen::MatrixXd& V, Eigen::MatrixXd* hv) {
 void SESyncCost::Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) {
   preconditioner_->Apply(V, &vq_);
   ProjectToStiefelProductTangent(Y_, vq_, d_, pv);
+}
+
+bool SESyncCost::UpdatePreconditioner(int inner_iterations, bool converged) {
+  return preconditioner_->Update(inner_iterations, converged);
 }
 
 void SESyncCost::Retract(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,

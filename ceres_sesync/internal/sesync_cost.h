@@ -5,6 +5,8 @@
 #ifndef CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 #define CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 
+#include <memory>
+
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/riemannian_trust_region.h"
@@ -16,6 +18,27 @@ enum class PreconditionerType {
   kBlockJacobi,     // Inverse diagonal blocks of D + eps I.
   kSparseCholesky,  // (D + eps I)^{-1} by sparse Cholesky.
   kRegularizedQ,    // (Q + eps I)^{-1} by sparse Cholesky of K_eps.
+  // Block-Jacobi while truncated CG converges in few iterations with it,
+  // then kRegularizedQ for the rest of the solve (see Update()).
+  kAdaptive,
+};
+
+// How the factor of kRegularizedQ / kAdaptive is stored (the factorization
+// itself is in double either way). Single halves the memory and the memory
+// traffic of every application; the operator is then (L~ L~^T)^{-1} for the
+// rounded factor L~: still symmetric positive definite, so truncated CG and
+// the trust region keep their guarantees, and within a small relative
+// perturbation of the double one (sparse_cholesky_factor.h).
+enum class FactorPrecision { kDouble, kSingle };
+
+struct PreconditionerSettings {
+  FactorPrecision precision = FactorPrecision::kDouble;
+  // kAdaptive switches to the exact preconditioner once a truncated-CG solve
+  // under block-Jacobi needs more than this many iterations. (It also
+  // switches when the stopping test is met under block-Jacobi, so that the
+  // test that ends a solve is always the exact preconditioner's, as with
+  // kRegularizedQ.)
+  int switch_iterations = 20;
 };
 
 // Approximate inverse of the Euclidean Hessian 2Q: either from
@@ -27,18 +50,46 @@ class SESyncPreconditioner {
  public:
   // kRegularizedQ factorizes K_eps in `workspace` when given (sharing its
   // symbolic analysis with the caller's certificate tests; the factor is
-  // copied, so the workspace may be refactorized afterwards).
+  // copied, so the workspace may be refactorized afterwards). kAdaptive
+  // factorizes only when it switches, in `workspace` (then it must outlive
+  // this object and must not be in use at that moment: the switch happens
+  // inside optimization) or in a workspace of its own.
   SESyncPreconditioner(const SESyncProblem& problem, PreconditionerType type,
                        double max_condition,
-                       CertificateMatrix* workspace = nullptr);
+                       CertificateMatrix* workspace = nullptr,
+                       const PreconditionerSettings& settings = {});
+  ~SESyncPreconditioner();
   // X = V (D + eps I)^{-1} (or the block-Jacobi version); V is r x dn.
   void Apply(const Eigen::MatrixXd& V, Eigen::MatrixXd* X) const;
   PreconditionerType type() const { return type_; }
 
+  // For kAdaptive (a no-op returning false otherwise): after a truncated-CG
+  // solve that took `inner_iterations` (converged = false), or when the
+  // stopping test was met (converged = true). Switches from block-Jacobi to
+  // the exact (Q + eps I)^{-1} when that solve needed more than
+  // settings.switch_iterations or on convergence, and returns true iff it
+  // switched (Apply() is then the exact operator from now on).
+  bool Update(int inner_iterations, bool converged);
+  // Whether Apply() is (Q + eps I)^{-1} now, and how often it switched.
+  bool exact() const { return exact_; }
+  int switches() const { return switches_; }
+  // The exact preconditioner's factor (empty before it is computed).
+  const SparseCholeskyFactor& factor() const { return factor_; }
+
  private:
+  // Factorizes K_eps and keeps its copy (kRegularizedQ, kAdaptive).
+  void FactorizeRegularizedQ();
+
+  const SESyncProblem& problem_;
   int d_;
   int num_threads_;
   PreconditionerType type_;
+  PreconditionerSettings settings_;
+  double eps_ = 0;
+  CertificateMatrix* workspace_ = nullptr;
+  std::unique_ptr<CertificateMatrix> own_workspace_;
+  bool exact_ = false;
+  int switches_ = 0;
   Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.
   // D + eps I (kSparseCholesky) or K_eps (kRegularizedQ, whose first
   // translation_size_ unknowns are the translations).
@@ -50,7 +101,7 @@ class SESyncCost : public RiemannianCostFunction {
  public:
   // Both must outlive this object.
   SESyncCost(const SESyncProblem* problem,
-             const SESyncPreconditioner* preconditioner);
+             SESyncPreconditioner* preconditioner);
 
   double Evaluate(const Eigen::MatrixXd& Y) override;
   void Gradient(Eigen::MatrixXd* gradient) override;
@@ -60,6 +111,8 @@ class SESyncCost : public RiemannianCostFunction {
                Eigen::MatrixXd* result) override;
   void ProjectToTangent(const Eigen::MatrixXd& V,
                         Eigen::MatrixXd* result) override;
+  // SESyncPreconditioner::Update (kAdaptive).
+  bool UpdatePreconditioner(int inner_iterations, bool converged) override;
 
   // Lagrange multipliers Lambda = SymBlockDiag_d(Q Y^T Y) (d x dn) at the
   // current point.
@@ -68,7 +121,7 @@ class SESyncCost : public RiemannianCostFunction {
 
  private:
   const SESyncProblem* problem_;
-  const SESyncPreconditioner* preconditioner_;
+  SESyncPreconditioner* preconditioner_;
   int d_;
   Eigen::MatrixXd Y_, YQ_, lambda_;
   Eigen::MatrixXd vq_, v_lambda_;  // Workspace of HessianVector/Precondition.

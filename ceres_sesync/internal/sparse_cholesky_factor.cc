@@ -1,90 +1,268 @@
 #include "ceres_sesync/internal/sparse_cholesky_factor.h"
 
 #include <algorithm>
+#include <numeric>
+#include <utility>
 
 #include "ceres_sesync/internal/parallel.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
+namespace {
+
+// Calls column(j, diagonal, rows, values) for j = 0 .. n-1 with column j of
+// the LL^T factor L: its diagonal entry and its entries below the diagonal
+// (ascending rows), read in place from a supernodal or simplicial factor.
+template <typename Column>
+void ForEachColumn(const cholmod_factor& L, Column column) {
+  std::vector<int> rows;
+  std::vector<double> values;
+  const double* x = static_cast<const double*>(L.x);
+  if (L.is_super) {
+    const auto* super = static_cast<const int*>(L.super);
+    const auto* pi = static_cast<const int*>(L.pi);
+    const auto* px = static_cast<const int*>(L.px);
+    const auto* s = static_cast<const int*>(L.s);
+    for (size_t k = 0; k < L.nsuper; ++k) {
+      const int height = pi[k + 1] - pi[k];
+      const int* row = s + pi[k];
+      for (int jj = 0; jj < super[k + 1] - super[k]; ++jj) {
+        const int j = super[k] + jj;
+        const double* col = x + px[k] + static_cast<size_t>(jj) * height;
+        CHECK_EQ(row[jj], j) << "supernode without leading diagonal";
+        rows.assign(row + jj + 1, row + height);
+        values.assign(col + jj + 1, col + height);
+        column(j, col[jj], &rows, &values);
+      }
+    }
+    return;
+  }
+  const auto* p = static_cast<const int*>(L.p);
+  const auto* nz = static_cast<const int*>(L.nz);
+  const auto* row = static_cast<const int*>(L.i);
+  for (int j = 0; j < static_cast<int>(L.n); ++j) {
+    const int begin = p[j], end = p[j] + nz[j];
+    CHECK(end > begin && row[begin] == j)
+        << "factor column without leading diagonal";
+    rows.assign(row + begin + 1, row + end);
+    values.assign(x + begin + 1, x + end);
+    column(j, x[begin], &rows, &values);
+  }
+}
+
+}  // namespace
 
 SparseCholeskyFactor::SparseCholeskyFactor(const cholmod_factor* factor,
                                            cholmod_common* common) {
-  cholmod_factor* L =
-      cholmod_copy_factor(const_cast<cholmod_factor*>(factor), common);
-  CHECK(L != nullptr) << "out of memory copying the Cholesky factor";
-  // Simplicial, LL^T, packed, monotonic: plain compressed columns, each
-  // starting with its diagonal entry.
-  CHECK(cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0,
-                              /*to_packed=*/1, /*to_monotonic=*/1, L, common))
-      << "cholmod_change_factor failed";
-  n_ = static_cast<int>(L->n);
-  const int* p = static_cast<const int*>(L->p);
-  const int* row = static_cast<const int*>(L->i);
-  const double* x = static_cast<const double*>(L->x);
-  const int* perm = static_cast<const int*>(L->Perm);
-  column_start_.resize(n_ + 1);
-  inverse_diagonal_.resize(n_);
-  permutation_.resize(n_);
-  values_.reserve(p[n_] - n_);
-  row_index_.reserve(p[n_] - n_);
-  for (int j = 0; j < n_; ++j) {
-    column_start_[j] = static_cast<int>(values_.size());
-    CHECK_EQ(row[p[j]], j) << "factor column without leading diagonal";
-    inverse_diagonal_[j] = 1.0 / x[p[j]];
-    for (int k = p[j] + 1; k < p[j + 1]; ++k) {
-      values_.push_back(x[k]);
-      row_index_.push_back(row[k]);
-    }
-    permutation_[j] = perm != nullptr ? perm[j] : j;
+  CHECK(factor != nullptr && factor->xtype == CHOLMOD_REAL)
+      << "no real numeric factor";
+  cholmod_factor* converted = nullptr;
+  const cholmod_factor* L = factor;
+  if (!factor->is_super && !factor->is_ll) {
+    // Simplicial LDL^T: a converted copy (LL^T, packed).
+    converted =
+        cholmod_copy_factor(const_cast<cholmod_factor*>(factor), common);
+    CHECK(converted != nullptr) << "out of memory copying the factor";
+    CHECK(cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0,
+                                /*to_packed=*/1, /*to_monotonic=*/1, converted,
+                                common))
+        << "cholmod_change_factor failed";
+    L = converted;
   }
-  column_start_[n_] = static_cast<int>(values_.size());
-  cholmod_free_factor(&L, common);
+  n_ = static_cast<int>(L->n);
+  const int* perm = static_cast<const int*>(L->Perm);
+  permutation_.resize(n_);
+  for (int j = 0; j < n_; ++j) permutation_[j] = perm != nullptr ? perm[j] : j;
+
+  // Two passes over L: the first counts what the second stores (so the
+  // arrays are allocated once, at their final size).
+  int64_t num_values = 0, num_rows = 0, num_supernodes = 0;
+  for (const bool fill : {false, true}) {
+    if (fill) {
+      values_.reserve(num_values);
+      row_index_.reserve(num_rows);
+      first_.reserve(num_supernodes + 1);
+      rows_.reserve(num_supernodes);
+    }
+    // The current supernode: columns j0 .. j0 + c - 1, the below-diagonal
+    // rows of its first column (`pattern`), its columns' diagonals and values.
+    int j0 = 0, c = 0;
+    std::vector<int> pattern;
+    std::vector<double> diagonal;
+    std::vector<std::vector<double>> columns;
+    std::vector<int> previous;  // Below-diagonal rows of column j - 1.
+    auto flush = [&] {
+      if (c == 0) return;
+      // Column k's below rows are pattern[k..]: the triangle rows j0+k+1 ..
+      // j0+c-1, then the rectangle rows pattern[c-1..].
+      const int nb = static_cast<int>(pattern.size()) - (c - 1);
+      const int64_t entries =
+          static_cast<int64_t>(c) * (c + 1) / 2 + static_cast<int64_t>(nb) * c;
+      if (!fill) {
+        num_values += entries;
+        num_rows += nb;
+        ++num_supernodes;
+      } else {
+        first_.push_back(j0);
+        rows_.push_back(nb);
+        row_index_.insert(row_index_.end(), pattern.begin() + (c - 1),
+                          pattern.end());
+        for (int k = 0; k < c; ++k) {
+          for (int q = 0; q < k; ++q) values_.push_back(columns[q][k - q - 1]);
+          values_.push_back(1.0 / diagonal[k]);
+        }
+        for (int i = 0; i < nb; ++i) {
+          for (int k = 0; k < c; ++k) {
+            values_.push_back(columns[k][(c - 1 - k) + i]);
+          }
+        }
+        stored_entries_ += entries;
+      }
+      c = 0;
+      columns.clear();
+      diagonal.clear();
+    };
+    ForEachColumn(*L, [&](int j, double diag, std::vector<int>* rows,
+                          std::vector<double>* values) {
+      // Sort by row (CHOLMOD's columns are sorted already; cheap to check),
+      // then drop exact zeros: structural zeros of relaxed supernodes.
+      if (!std::is_sorted(rows->begin(), rows->end())) {
+        std::vector<int> order(rows->size());
+        std::iota(order.begin(), order.end(), 0);
+        std::sort(order.begin(), order.end(),
+                  [&](int a, int b) { return (*rows)[a] < (*rows)[b]; });
+        std::vector<int> r(rows->size());
+        std::vector<double> v(rows->size());
+        for (size_t k = 0; k < order.size(); ++k) {
+          r[k] = (*rows)[order[k]];
+          v[k] = (*values)[order[k]];
+        }
+        *rows = std::move(r);
+        *values = std::move(v);
+      }
+      size_t kept = 0;
+      for (size_t k = 0; k < rows->size(); ++k) {
+        if ((*values)[k] != 0.0) {
+          (*rows)[kept] = (*rows)[k];
+          (*values)[kept] = (*values)[k];
+          ++kept;
+        }
+      }
+      rows->resize(kept);
+      values->resize(kept);
+      // Column j continues the supernode iff column j - 1's rows are {j}
+      // and then exactly column j's rows.
+      const bool joins =
+          c > 0 && !previous.empty() && previous[0] == j &&
+          previous.size() == rows->size() + 1 &&
+          std::equal(rows->begin(), rows->end(), previous.begin() + 1);
+      if (!joins) {
+        flush();
+        j0 = j;
+        pattern = *rows;
+      }
+      ++c;
+      diagonal.push_back(diag);
+      if (fill) columns.push_back(*values);
+      previous = *rows;
+    });
+    flush();
+  }
+  first_.push_back(n_);
+  if (converted != nullptr) cholmod_free_factor(&converted, common);
 }
 
-// Column j of W is the r-vector w_j. Forward: L Z = W^T column by column
-// (z_j = w_j / l_jj, then w_i -= l_ij z_j below the diagonal); backward:
-// L^T X = Z (x_j = (z_j - sum_i l_ij x_i) / l_jj).
-template <int R>
-void SparseCholeskyFactor::SolveInPlace(int r, double* w) const {
+void SparseCholeskyFactor::ConvertToSinglePrecision() {
+  if (single_precision() || values_.empty()) return;
+  values_float_.assign(values_.begin(), values_.end());
+  std::vector<double>().swap(values_);
+}
+
+int64_t SparseCholeskyFactor::memory_bytes() const {
+  return static_cast<int64_t>(values_.size()) * sizeof(double) +
+         static_cast<int64_t>(values_float_.size()) * sizeof(float) +
+         static_cast<int64_t>(row_index_.size() + first_.size() + rows_.size() +
+                              permutation_.size()) *
+             sizeof(int);
+}
+
+// Column j of W is the r-vector w_j. Forward, L Z = W^T by supernodes:
+// within the c columns of a supernode, z_k = (w_k - sum_q L(k, q) z_q) /
+// L(k, k); then every row i below gets w_i -= sum_k L(i, k) z_k. Backward,
+// L^T X = Z in reverse: the rows below (already solved) are subtracted from
+// the supernode's columns, then the triangle is solved from its last column.
+template <typename Scalar, int R>
+void SparseCholeskyFactor::SolveInPlace(const Scalar* values, int r,
+                                        double* w) const {
   using Vector = Eigen::Matrix<double, R, 1>;
   using Map = Eigen::Map<Vector>;
-  const int* start = column_start_.data();
-  const int* row = row_index_.data();
-  const double* value = values_.data();
-  for (int j = 0; j < n_; ++j) {
-    Map w_j(w + static_cast<std::ptrdiff_t>(j) * r, r);
-    w_j *= inverse_diagonal_[j];
-    for (int k = start[j]; k < start[j + 1]; ++k) {
-      Map(w + static_cast<std::ptrdiff_t>(row[k]) * r, r) -= value[k] * w_j;
-    }
-  }
+  const int num_supernodes = static_cast<int>(rows_.size());
+  const Scalar* v = values;
+  const int* below = row_index_.data();
+  auto column = [&](int j) {
+    return Map(w + static_cast<std::ptrdiff_t>(j) * r, r);
+  };
   Vector sum(r);
-  for (int j = n_ - 1; j >= 0; --j) {
-    Map w_j(w + static_cast<std::ptrdiff_t>(j) * r, r);
-    sum = w_j;
-    for (int k = start[j]; k < start[j + 1]; ++k) {
-      sum -= value[k] * Map(w + static_cast<std::ptrdiff_t>(row[k]) * r, r);
+  for (int s = 0; s < num_supernodes; ++s) {
+    const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
+    for (int k = 0; k < c; ++k) {
+      Map w_k = column(j0 + k);
+      for (int q = 0; q < k; ++q) {
+        w_k -= static_cast<double>(v[q]) * column(j0 + q);
+      }
+      w_k *= static_cast<double>(v[k]);
+      v += k + 1;
     }
-    w_j = sum * inverse_diagonal_[j];
+    for (int i = 0; i < nb; ++i, v += c) {
+      sum = static_cast<double>(v[0]) * column(j0);
+      for (int k = 1; k < c; ++k) {
+        sum += static_cast<double>(v[k]) * column(j0 + k);
+      }
+      column(below[i]) -= sum;
+    }
+    below += nb;
+  }
+  for (int s = num_supernodes - 1; s >= 0; --s) {
+    const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
+    below -= nb;
+    v -= static_cast<std::ptrdiff_t>(nb) * c;
+    const Scalar* rectangle = v;
+    for (int i = 0; i < nb; ++i, rectangle += c) {
+      const Map w_i = column(below[i]);
+      for (int k = 0; k < c; ++k) {
+        column(j0 + k) -= static_cast<double>(rectangle[k]) * w_i;
+      }
+    }
+    v -= static_cast<std::ptrdiff_t>(c) * (c + 1) / 2;
+    for (int k = c - 1; k >= 0; --k) {
+      const Scalar* row = v + static_cast<std::ptrdiff_t>(k) * (k + 1) / 2;
+      Map w_k = column(j0 + k);
+      w_k *= static_cast<double>(row[k]);
+      for (int q = 0; q < k; ++q) {
+        column(j0 + q) -= static_cast<double>(row[q]) * w_k;
+      }
+    }
   }
 }
 
-void SparseCholeskyFactor::SolvePermuted(int r, double* w) const {
+template <typename Scalar>
+void SparseCholeskyFactor::SolvePermuted(const Scalar* values, int r,
+                                         double* w) const {
   switch (r) {
     case 1:
-      return SolveInPlace<1>(r, w);
+      return SolveInPlace<Scalar, 1>(values, r, w);
     case 2:
-      return SolveInPlace<2>(r, w);
+      return SolveInPlace<Scalar, 2>(values, r, w);
     case 3:
-      return SolveInPlace<3>(r, w);
+      return SolveInPlace<Scalar, 3>(values, r, w);
     case 4:
-      return SolveInPlace<4>(r, w);
+      return SolveInPlace<Scalar, 4>(values, r, w);
     case 5:
-      return SolveInPlace<5>(r, w);
+      return SolveInPlace<Scalar, 5>(values, r, w);
     case 6:
-      return SolveInPlace<6>(r, w);
+      return SolveInPlace<Scalar, 6>(values, r, w);
     default:
-      return SolveInPlace<Eigen::Dynamic>(r, w);
+      return SolveInPlace<Scalar, Eigen::Dynamic>(values, r, w);
   }
 }
 
@@ -100,7 +278,7 @@ void SparseCholeskyFactor::SolveRowsTail(const Eigen::MatrixXd& B, int offset,
   CHECK_EQ(offset + B.cols(), n_);
   const int r = static_cast<int>(B.rows());
   X->resize(r, B.cols());
-  const double work = 4.0 * r * (values_.size() + n_);
+  const double work = 4.0 * r * stored_entries_;
   const int parts = std::min(r, ThreadsFor(num_threads, work));
   // Each part solves its own rows in a private contiguous workspace:
   // W = B P^T (with zero leading columns), solved, then X = W P.
@@ -116,7 +294,11 @@ void SparseCholeskyFactor::SolveRowsTail(const Eigen::MatrixXd& B, int offset,
         W.col(k).setZero();
       }
     }
-    SolvePermuted(rows, W.data());
+    if (single_precision()) {
+      SolvePermuted(values_float_.data(), rows, W.data());
+    } else {
+      SolvePermuted(values_.data(), rows, W.data());
+    }
     for (int k = 0; k < n_; ++k) {
       const int target = permutation_[k] - offset;
       if (target >= 0) X->col(target).segment(row, rows) = W.col(k);
