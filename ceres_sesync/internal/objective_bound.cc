@@ -12,11 +12,14 @@ double Gamma(double k) { return k * kU / (1 - k * kU); }
 
 }  // namespace
 
-double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses) {
+double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
+                           const MeasurementWeights& weights) {
   const int d = graph.dimension;
   const double g = Gamma(d + 2);
   double f = 0, error = 0;
-  for (const RelativePoseMeasurement& e : graph.measurements) {
+  for (size_t k = 0; k < graph.measurements.size(); ++k) {
+    const RelativePoseMeasurement& e = graph.measurements[k];
+    const Precisions w = WeightedPrecisions(e, weights, k);
     const Pose& a = poses[e.i];
     const Pose& b = poses[e.j];
     // Rotation residual R_j - R_i R~: entries (p, q).
@@ -48,8 +51,8 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses) {
       translation_error +=
           2 * std::abs(r) * entry_error + 2 * entry_error * entry_error;
     }
-    f += e.kappa * rotation + e.tau * translation;
-    error += e.kappa * rotation_error + e.tau * translation_error;
+    f += w.kappa * rotation + w.tau * translation;
+    error += w.kappa * rotation_error + w.tau * translation_error;
   }
   // The sums (squares of entries, weights, edges) and this computation's
   // own rounding: gamma over all terms, relative to their (nonnegative)

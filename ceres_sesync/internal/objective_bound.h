@@ -6,6 +6,7 @@
 #ifndef CERES_SESYNC_INTERNAL_OBJECTIVE_BOUND_H_
 #define CERES_SESYNC_INTERNAL_OBJECTIVE_BOUND_H_
 
+#include "ceres_sesync/internal/measurement_weights.h"
 #include "ceres_sesync/pose_graph.h"
 
 namespace ceres_sesync::internal {
@@ -17,8 +18,11 @@ namespace ceres_sesync::internal {
 // errs by at most 2|fl(r)| e + e^2 (+ the rounding of the square); the
 // weighted sums of m nonnegative terms err by at most gamma_{m+4} of their
 // value. Typically 1e-12 of F or less (more on large maps: the residuals
-// of translations far from the origin cancel more digits).
-double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses);
+// of translations far from the origin cancel more digits). With `weights`,
+// the same for the weighted problem (measurement_weights.h: its precisions
+// are doubles, so the analysis is unchanged).
+double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
+                           const MeasurementWeights& weights = {});
 
 }  // namespace ceres_sesync::internal
 

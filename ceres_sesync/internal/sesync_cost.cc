@@ -16,8 +16,16 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
                                            CertificateMatrix* workspace)
     : d_(problem.dimension()),
       num_threads_(problem.num_threads()),
-      type_(type) {
-  if (type == PreconditionerType::kNone) return;
+      type_(type),
+      max_condition_(max_condition) {
+  Update(problem, workspace);
+}
+
+SESyncPreconditioner::~SESyncPreconditioner() = default;
+
+void SESyncPreconditioner::Update(const SESyncProblem& problem,
+                                  CertificateMatrix* workspace) {
+  if (type_ == PreconditionerType::kNone) return;
   const SparseMatrix& D = problem.D();
   // Gershgorin bound on lambda_max(D).
   Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(D.rows());
@@ -26,9 +34,9 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
       row_sums(it.row()) += std::abs(it.value());
     }
   }
-  const double eps = row_sums.maxCoeff() / max_condition;
+  const double eps = row_sums.maxCoeff() / max_condition_;
   const int d = d_, n = problem.num_poses();
-  if (type == PreconditionerType::kBlockJacobi) {
+  if (type_ == PreconditionerType::kBlockJacobi) {
     block_inverses_.resize(d, d * n);
     const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(d, d);
     for (int i = 0; i < n; ++i) {
@@ -38,11 +46,14 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
     }
     return;
   }
-  if (type == PreconditionerType::kRegularizedQ) {
-    std::unique_ptr<CertificateMatrix> own;
+  if (type_ == PreconditionerType::kRegularizedQ) {
     if (workspace == nullptr) {
-      own = std::make_unique<CertificateMatrix>(problem);
-      workspace = own.get();
+      if (own_workspace_) {
+        own_workspace_->Refresh();
+      } else {
+        own_workspace_ = std::make_unique<CertificateMatrix>(problem);
+      }
+      workspace = own_workspace_.get();
     }
     CHECK(workspace->Factorize(Eigen::MatrixXd::Zero(d, d * n), eps))
         << "regularized Q preconditioner: factorization failed";
@@ -54,12 +65,15 @@ SESyncPreconditioner::SESyncPreconditioner(const SESyncProblem& problem,
   for (int k = 0; k < regularized.rows(); ++k) {
     regularized.coeffRef(k, k) += eps;
   }
-  CholmodFactor factor;
-  ConfigureCholmod(CholmodLayout::kSimplicial, &factor);
-  factor.compute(regularized);
-  CHECK(factor.info() == Eigen::Success)
+  if (!d_factor_) {
+    d_factor_ = std::make_unique<CholmodFactor>();
+    ConfigureCholmod(CholmodLayout::kSimplicial, d_factor_.get());
+    d_factor_->analyzePattern(regularized);
+  }
+  d_factor_->factorize(regularized);
+  CHECK(d_factor_->info() == Eigen::Success)
       << "regularized Cholesky preconditioner failed";
-  factor_ = factor.ExtractFactor();
+  factor_ = d_factor_->ExtractFactor();
 }
 
 void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,

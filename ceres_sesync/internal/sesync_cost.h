@@ -5,6 +5,8 @@
 #ifndef CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 #define CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 
+#include <memory>
+
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/riemannian_trust_region.h"
@@ -31,6 +33,12 @@ class SESyncPreconditioner {
   SESyncPreconditioner(const SESyncProblem& problem, PreconditionerType type,
                        double max_condition,
                        CertificateMatrix* workspace = nullptr);
+  ~SESyncPreconditioner();
+  // After problem.UpdateWeights() (and workspace->Refresh()): recomputes eps
+  // and refactorizes numerically, reusing the symbolic analysis (of the
+  // workspace for kRegularizedQ, of its own factor for kSparseCholesky).
+  void Update(const SESyncProblem& problem,
+              CertificateMatrix* workspace = nullptr);
   // X = V (D + eps I)^{-1} (or the block-Jacobi version); V is r x dn.
   void Apply(const Eigen::MatrixXd& V, Eigen::MatrixXd* X) const;
   PreconditionerType type() const { return type_; }
@@ -39,6 +47,11 @@ class SESyncPreconditioner {
   int d_;
   int num_threads_;
   PreconditionerType type_;
+  double max_condition_;
+  // The analyses kept for Update(): kSparseCholesky's factor of D + eps I,
+  // kRegularizedQ's own K_eps when no workspace is given.
+  std::unique_ptr<CholmodFactor> d_factor_;
+  std::unique_ptr<CertificateMatrix> own_workspace_;
   Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.
   // D + eps I (kSparseCholesky) or K_eps (kRegularizedQ, whose first
   // translation_size_ unknowns are the translations).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "ceres_sesync/internal/parallel.h"
@@ -205,11 +206,67 @@ void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
   common.print = 0;
 }
 
-SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
+SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
+                             MeasurementWeights weights)
     : graph_(&graph),
+      weights_(std::move(weights)),
       d_(graph.dimension),
       n_(graph.num_poses),
       num_threads_(std::max(1, num_threads)) {
+  const int n = n_;
+  CHECK(weights_.empty() || weights_.size() == graph.measurements.size());
+  std::vector<Triplet> lw;
+  Assemble(&lw);
+  if (n == 1) {
+    vertex_ordering_ = {0};
+    ok_ = true;
+    return;
+  }
+  // One fill-reducing ordering of the pose graph (on the pattern of
+  // L(W^tau)) serves Lbar here and the augmented matrices of
+  // certificate_matrix.h, whose (d+1)-blocks multiply its flops by about
+  // (d+1)^3 / 2. CHOLMOD's default choice (AMD here) is cheap; on large
+  // maps nested dissection (METIS) costs more to compute but leaves much
+  // less fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops
+  // (1.2x on city10000 and a 27,000-pose cube). So METIS is tried when the
+  // predicted flops of the augmented matrix exceed 2e4 per pose (about where
+  // its ~7 us per pose pays off), and kept if it predicts fewer flops.
+  {
+    SparseMatrix pattern(n, n);
+    pattern.setFromTriplets(lw.begin(), lw.end());
+    CholmodFactor analysis;
+    ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
+    analysis.analyzePattern(pattern);
+    vertex_ordering_ = analysis.Ordering();
+    const double block_flops = std::pow(d_ + 1.0, 3) / 2;
+    const double flops = analysis.cholmod().fl;
+    if (flops * block_flops > 2e4 * n) {
+      CholmodFactor nested;
+      ConfigureCholmod(CholmodLayout::kSimplicial, &nested);
+      cholmod_common& common = nested.cholmod();
+      common.nmethods = 1;
+      common.method[0].ordering = CHOLMOD_METIS;
+      nested.analyzePattern(pattern);
+      if (nested.info() == Eigen::Success && nested.cholmod().fl < flops) {
+        vertex_ordering_ = nested.Ordering();
+      }
+      VLOG(1) << "vertex ordering: AMD " << flops << " flops, METIS "
+              << nested.cholmod().fl;
+    }
+  }
+  std::vector<int> lbar_ordering;
+  lbar_ordering.reserve(n - 1);
+  for (int vertex : vertex_ordering_) {
+    if (vertex > 0) lbar_ordering.push_back(vertex - 1);
+  }
+  lbar_factor_ = std::make_unique<CholmodFactor>();
+  ConfigureCholmod(CholmodLayout::kSimplicial, lbar_factor_.get());
+  lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
+  FactorizeLbar();
+}
+
+void SESyncProblem::Assemble(std::vector<Triplet>* lw_terms) {
+  const PoseGraph& graph = *graph_;
   const int d = d_, n = n_;
   std::vector<Triplet> lrho, sigma, v, lw;
   const size_t m = graph.measurements.size();
@@ -219,23 +276,26 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   lw.reserve(4 * m);
   // Per row of M: the sum of |terms| and their number, for the rounding
   // bounds. Rows of D carry the terms of L(G^rho) and Sigma~ plus one more
-  // rounding (their sum).
+  // rounding (their sum). Exact zeros (the terms of zero weights) carry no
+  // rounding and are not counted, so the bounds of a problem with weights
+  // in {0, 1} are those of its weight-1 measurements alone.
   std::vector<double> t_abs(n, 0.0), r_abs(d * n, 0.0);
   std::vector<int> t_count(n, 0), r_count(d * n, 0);
   ForEachDataTerm<double>(
-      graph, [&](DataBlock block, int row, int col, double value) {
+      graph, weights_, [&](DataBlock block, int row, int col, double value) {
+        const int term = value != 0 ? 1 : 0;
         switch (block) {
           case DataBlock::kTranslation:
             lw.emplace_back(row, col, value);
             t_abs[row] += std::abs(value);
-            ++t_count[row];
+            t_count[row] += term;
             return;
           case DataBlock::kCoupling:  // M has -V at (row, col) and (col, row).
             v.emplace_back(row, col, value);
             t_abs[row] += std::abs(value);
-            ++t_count[row];
+            t_count[row] += term;
             r_abs[col] += std::abs(value);
-            ++r_count[col];
+            r_count[col] += term;
             return;
           case DataBlock::kRotation:
             lrho.emplace_back(row, col, value);
@@ -245,7 +305,7 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
             break;
         }
         r_abs[row] += std::abs(value);
-        ++r_count[row];
+        r_count[row] += term;
       });
   // Each stored entry is a sum of at most k rounded terms (a product of up
   // to three doubles: two roundings each) plus one rounding of the sum
@@ -263,6 +323,8 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   rotation_row_rounding_.resize(d * n);
   for (int i = 0; i < d * n; ++i)
     rotation_row_rounding_[i] = bound(r_count[i], r_abs[i]);
+  // setFromTriplets and the sparse sums below keep explicit zeros, so the
+  // patterns depend on the graph only.
   Lrho_.resize(d * n, d * n);
   Lrho_.setFromTriplets(lrho.begin(), lrho.end());
   SparseMatrix sigma_matrix(d * n, d * n);
@@ -288,56 +350,30 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   minus_Vbar_.makeCompressed();
   Lbar_.resize(n - 1, n - 1);
   Lbar_.setFromTriplets(lbar.begin(), lbar.end());
-  if (n == 1) {
-    vertex_ordering_ = {0};
-    ok_ = true;
-    return;
-  }
-  // One fill-reducing ordering of the pose graph (on the pattern of
-  // L(W^tau)) serves Lbar here and the augmented matrices of
-  // certificate_matrix.h, whose (d+1)-blocks multiply its flops by about
-  // (d+1)^3 / 2. CHOLMOD's default choice (AMD here) is cheap; on large
-  // maps nested dissection (METIS) costs more to compute but leaves much
-  // less fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops
-  // (1.2x on city10000 and a 27,000-pose cube). So METIS is tried when the
-  // predicted flops of the augmented matrix exceed 2e4 per pose (about where
-  // its ~7 us per pose pays off), and kept if it predicts fewer flops.
-  {
-    SparseMatrix pattern(n, n);
-    pattern.setFromTriplets(lw.begin(), lw.end());
-    CholmodFactor analysis;
-    ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
-    analysis.analyzePattern(pattern);
-    vertex_ordering_ = analysis.Ordering();
-    const double block_flops = std::pow(d + 1.0, 3) / 2;
-    const double flops = analysis.cholmod().fl;
-    if (flops * block_flops > 2e4 * n) {
-      CholmodFactor nested;
-      ConfigureCholmod(CholmodLayout::kSimplicial, &nested);
-      cholmod_common& common = nested.cholmod();
-      common.nmethods = 1;
-      common.method[0].ordering = CHOLMOD_METIS;
-      nested.analyzePattern(pattern);
-      if (nested.info() == Eigen::Success && nested.cholmod().fl < flops) {
-        vertex_ordering_ = nested.Ordering();
-      }
-      VLOG(1) << "vertex ordering: AMD " << flops << " flops, METIS "
-              << nested.cholmod().fl;
-    }
-  }
-  std::vector<int> lbar_ordering;
-  lbar_ordering.reserve(n - 1);
-  for (int vertex : vertex_ordering_) {
-    if (vertex > 0) lbar_ordering.push_back(vertex - 1);
-  }
-  lbar_factor_ = std::make_unique<CholmodFactor>();
-  ConfigureCholmod(CholmodLayout::kSimplicial, lbar_factor_.get());
-  lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
+  if (lw_terms) *lw_terms = std::move(lw);
+}
+
+void SESyncProblem::FactorizeLbar() {
   lbar_factor_->factorize(Lbar_);
   ok_ = lbar_factor_->info() == Eigen::Success;
   if (ok_) lbar_solver_ = lbar_factor_->ExtractFactor();
   LOG_IF(ERROR, !ok_) << "Cholesky factorization of the reduced translational "
                          "Laplacian failed";
+}
+
+bool SESyncProblem::UpdateWeights(MeasurementWeights weights) {
+  CHECK(weights.empty() || weights.size() == graph_->measurements.size());
+  weights_ = std::move(weights);
+  const Eigen::Index nnz_D = D_.nonZeros(), nnz_V = Vbar_.nonZeros(),
+                     nnz_L = Lbar_.nonZeros();
+  Assemble(nullptr);
+  // The patterns are functions of the graph alone (see Assemble()).
+  CHECK(D_.nonZeros() == nnz_D && Vbar_.nonZeros() == nnz_V &&
+        Lbar_.nonZeros() == nnz_L)
+      << "re-weighting changed a sparsity pattern";
+  if (n_ == 1) return ok_ = true;
+  FactorizeLbar();
+  return ok_;
 }
 
 void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,

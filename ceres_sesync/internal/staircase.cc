@@ -1,5 +1,6 @@
 #include "ceres_sesync/internal/staircase.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -111,16 +112,57 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
       *problem_, ToInternal(options.preconditioner),
       options.regularized_cholesky_max_condition, certificate_.get());
   cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
+  SetScales();
+  s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
+  ok_ = true;
+}
+
+void Staircase::SetScales() {
   scale_ = MaxDiagonal(problem_->D());
   // Objective values below this are zero up to round-off (F is a sum of
   // squares weighted by kappa and tau).
   double total_weight = 0;
-  for (const RelativePoseMeasurement& e : graph.measurements) {
-    total_weight += e.kappa + e.tau;
+  const MeasurementWeights& weights = problem_->weights();
+  for (size_t k = 0; k < graph_.measurements.size(); ++k) {
+    const Precisions p = WeightedPrecisions(graph_.measurements[k], weights, k);
+    total_weight += p.kappa + p.tau;
   }
   zero_objective_ = 1e-12 * total_weight;
+}
+
+bool Staircase::Reweight(MeasurementWeights weights, Clock::time_point start) {
+  CHECK(problem_ != nullptr) << "Reweight() needs a valid, non-trivial problem";
+  start_ = start;
+  const int m = static_cast<int>(graph_.measurements.size());
+  SolverSummary& s = *summary_;
+  s = SolverSummary();
+  s.lambda_min_estimate = std::numeric_limits<double>::quiet_NaN();
+  s.dimension = d_;
+  s.num_poses = n_;
+  s.num_measurements =
+      weights.empty()
+          ? m
+          : static_cast<int>(std::count_if(weights.begin(), weights.end(),
+                                           [](double w) { return w > 0; }));
+  ok_ = false;
+  if (!CheckMeasurementWeights(graph_, weights, &s.message)) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    return false;
+  }
+  const auto t = Clock::now();
+  if (!problem_->UpdateWeights(std::move(weights))) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message = "the translational Laplacian is not positive definite";
+    return false;
+  }
+  certificate_->Refresh();
+  preconditioner_->Update(*problem_, certificate_.get());
+  SetScales();
+  verification_ = VerificationResult();
+  sdp_value_ = lower_bound_ = 0;
+  extended_deferred_ = false;
   s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
-  ok_ = true;
+  return ok_ = true;
 }
 
 Staircase::~Staircase() = default;
@@ -443,7 +485,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
 
 void Staircase::Report(const Eigen::MatrixXd& Y, const Poses& poses) {
   SolverSummary& s = *summary_;
-  s.objective = EvaluateObjective(graph_, poses);
+  s.objective = WeightedObjective(graph_, problem_->weights(), poses);
   if (extended_deferred_ && verification_.certified) {
     TightenProof(Y, s.objective);
   }
@@ -461,7 +503,8 @@ void Staircase::Report(const Eigen::MatrixXd& Y, const Poses& poses) {
   s.lower_bound = std::min(s.lower_bound, s.objective);
   // F(x) rounded up: the bound must not rest on round-off in F.
   s.suboptimality_bound =
-      std::max(0.0, ObjectiveUpperBound(graph_, poses) - s.lower_bound);
+      std::max(0.0, ObjectiveUpperBound(graph_, poses, problem_->weights()) -
+                        s.lower_bound);
   // A numerically zero F is optimal by F >= 0 (no ratio to a zero bound).
   s.relative_suboptimality_bound =
       s.objective <= zero_objective_ ? 0

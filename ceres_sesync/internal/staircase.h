@@ -18,6 +18,16 @@
 //
 // Every stage records what it did in the SolverSummary given at
 // construction (times, levels, counts).
+//
+// Weighted problems (measurement_weights.h; the GNC loop of robust_solver.cc)
+// reuse one Staircase: Reweight() changes the data matrices' values in place
+// (keeping every symbolic analysis) and starts a new solve, which Run()
+// warm-starts from the previous Y:
+//
+//   staircase.Reweight(weights);   // a new solve of the weighted problem
+//   staircase.Run(&Y);             // from the previous factor
+//   Poses poses = staircase.Round(Y);
+//   staircase.Report(Y, poses);    // F, bounds: of the weighted problem
 
 #ifndef CERES_SESYNC_INTERNAL_STAIRCASE_H_
 #define CERES_SESYNC_INTERNAL_STAIRCASE_H_
@@ -56,6 +66,19 @@ class Staircase {
   bool trivial() const { return trivial_; }
   Poses Trivial() const;
 
+  // Starts a new solve of the problem with these measurement weights
+  // (empty: all 1): the data matrices, the certificate matrix and the
+  // preconditioner get the new values (same patterns: the symbolic analyses
+  // are kept), the summary is reset as by the constructor (num_measurements:
+  // those of positive weight; data_time_s: this update) and time limits
+  // count from `start`. Returns false, with the summary's status
+  // kInvalidInput and a message, if the weights fail
+  // CheckMeasurementWeights (e.g. the positively weighted measurements leave
+  // the graph disconnected); ok() is then false until a successful
+  // Reweight(). Not for trivial problems.
+  bool Reweight(MeasurementWeights weights,
+                Clock::time_point start = Clock::now());
+
   // Stage "initialize": Y (r0 x dn) from `initial` (its rotations projected
   // to SO(d)) or, if null, from options.initialization. False (summary has
   // the status) if the requested initialization is unavailable.
@@ -92,6 +115,8 @@ class Staircase {
 
  private:
   double Elapsed() const;
+  // scale_ and zero_objective_ from the problem's current data.
+  void SetScales();
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
   // One level's local optimization (RTR or Ceres LBFGS) from Y.
