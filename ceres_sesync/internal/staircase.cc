@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <utility>
 
 #include "ceres_sesync/internal/ceres_local_solver.h"
 #include "ceres_sesync/internal/chordal.h"
@@ -70,7 +71,8 @@ Poses ToPosesInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
 }
 
 Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
-                     SolverSummary* summary, Clock::time_point start)
+                     SolverSummary* summary, Clock::time_point start,
+                     MeasurementWeights weights)
     : graph_(graph), options_(options), summary_(summary), start_(start) {
   *summary_ = SolverSummary();
   SolverSummary& s = *summary_;
@@ -78,9 +80,14 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   s.dimension = graph.dimension;
   s.num_poses = graph.num_poses;
   s.num_measurements = static_cast<int>(graph.measurements.size());
-  if (!ValidatePoseGraph(graph, &s.message)) {
+  if (!ValidatePoseGraph(graph, &s.message) ||
+      !CheckMeasurementWeights(graph, weights, &s.message)) {
     s.status = SolverSummary::Status::kInvalidInput;
     return;
+  }
+  if (!weights.empty()) {
+    s.num_measurements = static_cast<int>(std::count_if(
+        weights.begin(), weights.end(), [](double w) { return w > 0; }));
   }
   d_ = graph.dimension;
   n_ = graph.num_poses;
@@ -101,7 +108,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
 
   const auto t = Clock::now();
   problem_ = std::make_unique<SESyncProblem>(
-      graph, ResolveNumThreads(options.num_threads));
+      graph, ResolveNumThreads(options.num_threads), std::move(weights));
   if (!problem_->ok()) {
     s.status = SolverSummary::Status::kInvalidInput;
     s.message = "the translational Laplacian is not positive definite";

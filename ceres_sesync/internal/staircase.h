@@ -49,12 +49,15 @@ class Staircase {
  public:
   using Clock = std::chrono::steady_clock;
 
-  // Stage "problem": validates `graph` and `options` and builds the data
-  // matrices, the certificate matrix's symbolic analysis and the
-  // preconditioner. `graph`, `options` and `summary` must outlive this
-  // object; `summary` is reset. Time limits count from `start`.
+  // Stage "problem": validates `graph`, `options` and `weights`
+  // (measurement_weights.h; empty: all 1) and builds the data matrices of
+  // the (weighted) problem, the certificate matrix's symbolic analysis and
+  // the preconditioner. `graph`, `options` and `summary` must outlive this
+  // object (options are read at every stage); `summary` is reset. Time
+  // limits count from `start`.
   Staircase(const PoseGraph& graph, const SolverOptions& options,
-            SolverSummary* summary, Clock::time_point start = Clock::now());
+            SolverSummary* summary, Clock::time_point start = Clock::now(),
+            MeasurementWeights weights = {});
   ~Staircase();
 
   // False if validation or the data matrices failed (summary has the status
