@@ -18,6 +18,14 @@
 //    (x, y, z, w) on ceres::EigenQuaternionManifold; residual (12 entries)
 //    with vec(R(q_j) - R(q_i) R~) (9) and the translation term (3).
 // Jacobians by automatic differentiation.
+//
+// Robust losses (CeresRobustLoss): each measurement's residual block gets a
+// ceres::LossFunction on its squared norm s = f_k, the measurement's term of
+// eq. (12). With the scale a = sqrt(threshold) (Ceres's parameter),
+//   Huber:  rho(s) = s for s <= a^2, 2 a sqrt(s) - a^2 beyond;
+//   Cauchy: rho(s) = a^2 log(1 + s / a^2),
+// so threshold = c^2, the TLS threshold of robust_solver.h, compares the
+// losses with the robust solve on the same scale.
 
 #ifndef CERES_SESYNC_CERES_BASELINE_H_
 #define CERES_SESYNC_CERES_BASELINE_H_
@@ -30,6 +38,17 @@
 #include "ceres_sesync/pose_graph.h"
 
 namespace ceres_sesync {
+
+struct CeresRobustLoss {
+  enum class Type {
+    kNone,    // Least squares (no loss function).
+    kHuber,   // ceres::HuberLoss(sqrt(threshold)).
+    kCauchy,  // ceres::CauchyLoss(sqrt(threshold)).
+  };
+  Type type = Type::kNone;
+  // a^2 on f_k (> 0 with a loss): where the loss leaves the quadratic.
+  double threshold = 0;
+};
 
 struct CeresBaselineOptions {
   enum class Method {
@@ -58,6 +77,8 @@ struct CeresBaselineOptions {
   // Log per-iteration progress to stdout (Ceres's minimizer_progress_to_
   // stdout).
   bool verbose = false;
+  // Robust loss on every measurement (default: none, least squares).
+  CeresRobustLoss loss;
 };
 
 struct CeresBaselineSummary {
@@ -67,6 +88,10 @@ struct CeresBaselineSummary {
   double initial_objective = 0;
   // F at the returned poses, on the scale of eq. (12).
   double final_objective = 0;
+  // What Ceres minimized, 2 * its cost: sum_k rho(f_k) with a robust loss,
+  // else F (equal to the objectives above).
+  double initial_robust_objective = 0;
+  double final_robust_objective = 0;
   // Number of trust-region iterations (successful + unsuccessful steps).
   int iterations = 0;
   // Wall time of ceres::Solve, in seconds.
@@ -104,10 +129,13 @@ struct CeresPoseBlocks {
 // blocks in `blocks` (which must outlive `problem` and have graph.num_poses
 // poses), sets the quaternion manifolds (3D) and holds the gauge pose
 // (graph.fixed_pose if >= 0, else pose 0) constant. `problem` should be empty
-// and use the default ownership options. Returns false (problem untouched)
-// if the graph fails ValidatePoseGraph or the sizes disagree.
+// and use the default ownership options. `loss` (default: none) puts a
+// robust loss on every measurement. Returns false (problem untouched) if the
+// graph fails ValidatePoseGraph, the sizes disagree or a loss has no
+// positive finite threshold.
 bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
-                       ceres::Problem* problem, std::string* error);
+                       ceres::Problem* problem, std::string* error,
+                       const CeresRobustLoss& loss = {});
 
 // Minimizes eq. (12) with Ceres from `initial` (graph.num_poses poses). The
 // gauge pose (graph.fixed_pose if >= 0, else pose 0) stays at its initial

@@ -225,6 +225,14 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
   }
   if (o.max_iterations < 0) return "max_iterations must be >= 0";
   if (o.initial_max_rank < 0) return "initial_max_rank must be >= 0";
+  if (o.gnc_threshold_fractions.empty()) {
+    return "gnc_threshold_fractions must not be empty";
+  }
+  for (double fraction : o.gnc_threshold_fractions) {
+    if (!(fraction > 0 && fraction <= 1)) {
+      return "gnc_threshold_fractions must be in (0, 1]";
+    }
+  }
   if (o.max_consistency_rounds < 0) {
     return "max_consistency_rounds must be >= 0";
   }
@@ -253,6 +261,35 @@ double InlierThreshold(const RobustSolverOptions& options, int dimension) {
                                      dimension * (dimension + 1) / 2);
 }
 
+namespace {
+
+// One GNC schedule from the first solve's result, with its final inlier
+// problem and consistency rounds.
+struct GncRun {
+  RobustSolverSummary::Run record;
+  RobustSolverSummary::Status status = RobustSolverSummary::Status::kConverged;
+  std::string message;
+  Poses poses;
+  MeasurementWeights weights;
+  std::vector<char> accepted;
+  std::vector<RobustSolverSummary::Iteration> history;
+  SolverSummary inlier_summary;
+  bool weights_binary = false;
+};
+
+// sum_k min(f_k, c^2) over the estimated measurements plus f_k of the known
+// inliers, at `poses`.
+double TlsCost(const std::vector<double>& f, const std::vector<char>& known,
+               double c2) {
+  double cost = 0;
+  for (size_t k = 0; k < f.size(); ++k) {
+    cost += known[k] ? f[k] : std::min(f[k], c2);
+  }
+  return cost;
+}
+
+}  // namespace
+
 Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
                   RobustSolverSummary* summary) {
   const auto start = Clock::now();
@@ -276,11 +313,11 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   const double c2 = InlierThreshold(options, d);
   s.inlier_threshold = c2;
 
-  // The first solve is Solve() itself. GNC's weighted solves then prove
-  // their certificates in double only (they decide saddle escapes; no bound
-  // of theirs is reported); the final inlier problem's proof uses the
-  // caller's arithmetic again. The Staircase reads its options at every
-  // stage.
+  // The first solve is Solve() itself (up to initial_max_rank). GNC's
+  // weighted solves then prove their certificates in double only (they
+  // decide saddle escapes; no bound of theirs is reported); each final
+  // inlier problem's proof uses the caller's arithmetic again. The
+  // Staircase reads its options at every stage.
   SolverOptions solve_options = options.solver_options;
   const int r0 = options.solver_options.initial_rank > 0
                      ? options.solver_options.initial_rank
@@ -290,8 +327,6 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
                                       std::max(options.initial_max_rank, r0));
   }
   WeightedProblem problem(graph, solve_options);
-
-  // The first solve: every weight 1, i.e. Solve() up to initial_max_rank.
   problem.Start(start);
   auto invalid = [&]() {
     s.message = problem.summary().message;
@@ -311,82 +346,95 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     return finish(RobustSolverSummary::Status::kConverged,
                   problem.staircase().Trivial());
   }
-  Eigen::MatrixXd Y;
-  if (!problem.staircase().Initialize(nullptr, &Y)) return invalid();
-  problem.staircase().Run(&Y);
-  Poses poses = problem.staircase().Round(Y);
-  bool reported = false;
-  auto report = [&]() {
-    problem.staircase().Report(Y, poses);
-    reported = true;
-  };
-  std::vector<double> f = Costs(graph, poses);
+  Eigen::MatrixXd Y0;
+  if (!problem.staircase().Initialize(nullptr, &Y0)) return invalid();
+  problem.staircase().Run(&Y0);
+  Poses poses0 = problem.staircase().Round(Y0);
+  const std::vector<double> f0 = Costs(graph, poses0);
   double max_cost = 0;
   for (size_t k = 0; k < m; ++k) {
-    if (!known[k]) max_cost = std::max(max_cost, f[k]);
+    if (!known[k]) max_cost = std::max(max_cost, f0[k]);
   }
   solve_options.max_rank = options.solver_options.max_rank;
-  if (max_cost <= c2 &&
-      problem.summary().status == SolverSummary::Status::kMaxRankReached &&
-      problem.summary().final_rank < solve_options.max_rank) {
-    // Every measurement fits, so this is the inlier problem: the staircase
-    // continues where the rank cap stopped it (as Solve() would).
-    problem.staircase().Run(&Y);
-    poses = problem.staircase().Round(Y);
+  if (max_cost <= c2) {
+    // Every measurement fits: this is the inlier problem. The staircase
+    // continues where a rank cap stopped it (as Solve() would).
+    if (problem.summary().status == SolverSummary::Status::kMaxRankReached &&
+        problem.summary().final_rank < solve_options.max_rank) {
+      problem.staircase().Run(&Y0);
+      poses0 = problem.staircase().Round(Y0);
+    }
+    problem.staircase().Report(Y0, poses0);
+    s.initial_summary = s.inlier_summary = problem.summary();
+    s.initial_time_s = s.total_time_s = Seconds(start);
+    s.weights_binary = true;
+    FillEdges(graph, poses0, MeasurementWeights(m, 1.0), known,
+              std::vector<char>(m, 1), c2, &s);
+    return finish(RobustSolverSummary::Status::kConverged, poses0);
   }
-  report();
+  problem.staircase().Report(Y0, poses0);
   s.initial_summary = problem.summary();
-  solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
   s.initial_time_s = Seconds(start);
+  const double g0 = options.gnc_threshold_fractions[0] * c2;
+  s.initial_mu = g0 / (2 * max_cost - g0);
 
   // GNC (Yang et al. 2020, Algorithm 1 with TLS) as in GTSAM's
-  // GncOptimizer: weights from the last estimate, weighted solve warm-
-  // started from the last factor (its negligible directions dropped), mu
-  // update, convergence test.
-  MeasurementWeights weights(m, 1.0);  // Of the last solved problem.
-  RobustSolverSummary::Status status = RobustSolverSummary::Status::kConverged;
-  const int min_rank = r0;
-  const auto gnc_start = Clock::now();
-  std::string message;
-  if (max_cost > c2) {
-    double mu = c2 / (2 * max_cost - c2);
-    s.initial_mu = mu;
+  // GncOptimizer, from the first solve, at GNC threshold g2: weights from
+  // the last estimate, weighted solve warm-started from the last factor
+  // (its negligible directions dropped), mu update, convergence test; then
+  // the accepted set's problem, certified, and the consistency rounds at c^2.
+  auto run_gnc = [&](double fraction) {
+    const auto run_start = Clock::now();
+    GncRun run;
+    run.record.gnc_threshold = fraction * c2;
+    const double g2 = run.record.gnc_threshold;
+    Eigen::MatrixXd Y = Y0;
+    run.poses = poses0;
+    std::vector<double> f = f0;
+    run.weights.assign(m, 1.0);  // Of the last solved problem.
+    bool reported = true;        // The first solve was reported.
+    std::string message;
+    double mu = g2 / (2 * max_cost - g2);
     auto surrogate = [&](double mu_k) {
       double cost = 0;
       for (size_t k = 0; k < m; ++k) {
-        cost += known[k] ? f[k] : TlsSurrogate(f[k], mu_k, c2);
+        cost += known[k] ? f[k] : TlsSurrogate(f[k], mu_k, g2);
       }
       return cost;
     };
+    auto disconnected = [&](const std::string& what) {
+      run.status = RobustSolverSummary::Status::kInlierGraphDisconnected;
+      run.message = what + message;
+      run.record.time_s = Seconds(run_start);
+      return run;
+    };
     double previous_cost = surrogate(mu);
-    status = RobustSolverSummary::Status::kMaxIterations;
+    run.status = RobustSolverSummary::Status::kMaxIterations;
+    solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
     for (int it = 0; it < options.max_iterations; ++it) {
       const auto step_start = Clock::now();
       MeasurementWeights next(m);
       for (size_t k = 0; k < m; ++k) {
-        next[k] = known[k] ? 1.0 : TlsWeight(f[k], mu, c2);
+        next[k] = known[k] ? 1.0 : TlsWeight(f[k], mu, g2);
       }
       if (!problem.SetWeights(next, &message)) {
-        s.message = "GNC step " + std::to_string(it + 1) + ": " + message;
-        std::vector<char> positive(m);
-        for (size_t k = 0; k < m; ++k) positive[k] = next[k] > 0.5;
-        FillEdges(graph, poses, next, known, positive, c2, &s);
-        s.gnc_time_s = Seconds(gnc_start);
-        return finish(RobustSolverSummary::Status::kInlierGraphDisconnected,
-                      poses);
+        run.accepted.assign(m, 0);
+        for (size_t k = 0; k < m; ++k) run.accepted[k] = next[k] > 0.5;
+        run.weights = next;
+        return disconnected("GNC step " + std::to_string(it + 1) + ": ");
       }
-      weights = std::move(next);
-      Y = ReduceRank(Y, d, min_rank, kRankTolerance);
+      run.weights = std::move(next);
+      Y = ReduceRank(Y, d, r0, kRankTolerance);
       problem.staircase().Run(&Y);
-      poses = problem.staircase().Round(Y);
+      run.poses = problem.staircase().Round(Y);
       reported = false;
-      f = Costs(graph, poses);
+      f = Costs(graph, run.poses);
       const double cost = surrogate(mu);
       const SolverSummary& solve = problem.summary();
       RobustSolverSummary::Iteration record;
       record.mu = mu;
       record.surrogate_cost = cost;
-      for (double w : weights) {
+      for (double w : run.weights) {
         record.num_zero_weights += w == 0;
         record.num_unit_weights += w == 1;
       }
@@ -396,77 +444,108 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       record.optimization_time_s = solve.optimization_time_s;
       record.verification_time_s = solve.verification_time_s;
       record.time_s = Seconds(step_start);
-      s.history.push_back(record);
-      s.iterations = it + 1;
+      run.history.push_back(record);
+      run.record.iterations = it + 1;
       mu *= options.mu_step;
-      if (Binary(weights, options.weight_tolerance) ||
+      if (Binary(run.weights, options.weight_tolerance) ||
           std::abs(cost - previous_cost) <=
               options.relative_cost_tolerance * previous_cost) {
-        status = RobustSolverSummary::Status::kConverged;
+        run.status = RobustSolverSummary::Status::kConverged;
         break;
       }
       previous_cost = cost;
     }
+    run.weights_binary = Binary(run.weights, options.weight_tolerance);
+
+    // The problem restricted to the accepted measurements (weights rounded
+    // at 1/2), solved from the last factor, proven in the caller's
+    // arithmetic.
+    solve_options.proof_arithmetic = options.solver_options.proof_arithmetic;
+    run.accepted.assign(m, 0);
+    for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
+    auto solve_accepted = [&]() {
+      MeasurementWeights binary(m);
+      for (size_t k = 0; k < m; ++k) binary[k] = run.accepted[k] ? 1.0 : 0.0;
+      if (!problem.SetWeights(binary, &message)) return false;
+      Y = ReduceRank(Y, d, r0, kRankTolerance);
+      problem.staircase().Run(&Y);
+      run.poses = problem.staircase().Round(Y);
+      reported = false;
+      return true;
+    };
+    bool binary = true;
+    for (size_t k = 0; k < m; ++k) {
+      binary = binary && run.weights[k] == run.accepted[k];
+    }
+    // A new solve unless the last one was this problem already, proven in
+    // the caller's arithmetic (GNC steps prove in double).
+    if ((!binary || (run.record.iterations > 0 &&
+                     options.solver_options.proof_arithmetic !=
+                         SolverOptions::ProofArithmetic::kDouble)) &&
+        !solve_accepted()) {
+      return disconnected("the accepted measurements: ");
+    }
+    // Consistency at c^2: accept exactly the measurements within it at the
+    // inlier problem's optimum. Each change lowers the TLS cost (at fixed
+    // poses the new set takes min(f_k, c^2) per measurement; the re-solve
+    // lowers the accepted sum), so the rounds end.
+    for (int round = 0; round < options.max_consistency_rounds; ++round) {
+      f = Costs(graph, run.poses);
+      bool changed = false;
+      for (size_t k = 0; k < m; ++k) {
+        if (known[k] || run.accepted[k] == (f[k] <= c2)) continue;
+        run.accepted[k] = f[k] <= c2;
+        changed = true;
+      }
+      if (!changed) break;
+      ++run.record.consistency_rounds;
+      if (!solve_accepted()) {
+        return disconnected("consistency round " + std::to_string(round + 1) +
+                            ": ");
+      }
+    }
+    if (!reported) problem.staircase().Report(Y, run.poses);
+    run.inlier_summary = problem.summary();
+    f = Costs(graph, run.poses);
+    run.record.tls_cost = TlsCost(f, known, c2);
+    for (char a : run.accepted) run.record.num_outliers += !a;
+    run.record.certified = run.inlier_summary.certified();
+    run.record.time_s = Seconds(run_start);
+    return run;
+  };
+
+  // Every schedule; the lowest TLS cost at c^2 wins (the first on ties).
+  const auto gnc_start = Clock::now();
+  GncRun best;
+  int best_index = -1;
+  for (size_t q = 0; q < options.gnc_threshold_fractions.size(); ++q) {
+    GncRun run = run_gnc(options.gnc_threshold_fractions[q]);
+    run.record.status = run.status;
+    s.runs.push_back(run.record);
+    const bool usable =
+        run.status != RobustSolverSummary::Status::kInlierGraphDisconnected;
+    const bool best_usable =
+        best_index >= 0 &&
+        best.status != RobustSolverSummary::Status::kInlierGraphDisconnected;
+    if (best_index < 0 ||
+        (usable &&
+         (!best_usable || run.record.tls_cost < best.record.tls_cost))) {
+      best = std::move(run);
+      best_index = static_cast<int>(q);
+    }
   }
   s.gnc_time_s = Seconds(gnc_start);
-  s.weights_binary = Binary(weights, options.weight_tolerance);
-
-  // The problem restricted to the accepted measurements (weights rounded at
-  // 1/2), solved from the last factor and certified in the caller's
-  // arithmetic.
-  const auto inlier_start = Clock::now();
-  solve_options.proof_arithmetic = options.solver_options.proof_arithmetic;
-  std::vector<char> accepted(m);
-  for (size_t k = 0; k < m; ++k) accepted[k] = weights[k] > 0.5;
-  auto disconnected = [&]() {
-    s.message = "the accepted measurements: " + message;
-    s.inlier_time_s = Seconds(inlier_start);
-    s.pattern_rebuilds = problem.rebuilds();
-    FillEdges(graph, poses, weights, known, accepted, c2, &s);
-    return finish(RobustSolverSummary::Status::kInlierGraphDisconnected, poses);
-  };
-  auto solve_accepted = [&]() {
-    MeasurementWeights binary(m);
-    for (size_t k = 0; k < m; ++k) binary[k] = accepted[k] ? 1.0 : 0.0;
-    if (!problem.SetWeights(binary, &message)) return false;
-    Y = ReduceRank(Y, d, min_rank, kRankTolerance);
-    problem.staircase().Run(&Y);
-    poses = problem.staircase().Round(Y);
-    reported = false;
-    return true;
-  };
-  bool binary = true;
-  for (size_t k = 0; k < m; ++k) binary = binary && weights[k] == accepted[k];
-  // A new solve unless the last one was this problem already (and proven in
-  // the caller's arithmetic: GNC steps prove in double).
-  if ((!binary ||
-       (s.iterations > 0 && options.solver_options.proof_arithmetic !=
-                                SolverOptions::ProofArithmetic::kDouble)) &&
-      !solve_accepted()) {
-    return disconnected();
-  }
-  // Consistency: accept exactly the measurements within the threshold at
-  // the inlier problem's optimum. Each change lowers the TLS cost (at fixed
-  // poses the new set takes min(f_k, c^2) per measurement; the re-solve
-  // lowers the accepted sum), so the rounds end.
-  for (int round = 0; round < options.max_consistency_rounds; ++round) {
-    f = Costs(graph, poses);
-    bool changed = false;
-    for (size_t k = 0; k < m; ++k) {
-      if (known[k] || accepted[k] == (f[k] <= c2)) continue;
-      accepted[k] = f[k] <= c2;
-      changed = true;
-    }
-    if (!changed) break;
-    ++s.consistency_rounds;
-    if (!solve_accepted()) return disconnected();
-  }
-  if (!reported) report();
-  s.inlier_summary = problem.summary();
-  s.inlier_time_s = Seconds(inlier_start);
+  s.selected_run = best_index;
+  s.gnc_threshold = best.record.gnc_threshold;
+  s.iterations = best.record.iterations;
+  s.consistency_rounds = best.record.consistency_rounds;
+  s.history = std::move(best.history);
+  s.weights_binary = best.weights_binary;
+  s.message = best.message;
+  s.inlier_summary = best.inlier_summary;
   s.pattern_rebuilds = problem.rebuilds();
-  FillEdges(graph, poses, weights, known, accepted, c2, &s);
-  return finish(status, poses);
+  FillEdges(graph, best.poses, best.weights, known, best.accepted, c2, &s);
+  return finish(best.status, std::move(best.poses));
 }
 
 bool RobustSolverSummary::certified() const {
@@ -530,8 +609,22 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   line("%-34s %.6g\n", "TLS threshold c^2 on f_k", inlier_threshold);
   out += "\nFirst solve (all weights 1: plain SE-Sync)\n";
   line("  %s\n", initial_summary.BriefReport().c_str());
-  out += "\nGraduated non-convexity\n";
-  line("%-34s %.3e\n", "Initial mu", initial_mu);
+  out += "\nGraduated non-convexity: runs (the lowest TLS cost is kept)\n";
+  line("  %4s %11s %24s %6s %6s %9s %18s %9s %9s\n", "run", "GNC c^2", "status",
+       "iters", "rounds", "rejected", "TLS cost at c^2", "certified",
+       "time [s]");
+  for (size_t q = 0; q < runs.size(); ++q) {
+    const Run& r = runs[q];
+    RobustSolverSummary status_only;
+    status_only.status = r.status;
+    line("  %4d %11.4g %24s %6d %6d %9d %18.10g %9s %9.3f%s\n",
+         static_cast<int>(q + 1), r.gnc_threshold,
+         status_only.StatusString().c_str(), r.iterations, r.consistency_rounds,
+         r.num_outliers, r.tls_cost, r.certified ? "yes" : "no", r.time_s,
+         static_cast<int>(q) == selected_run ? "  <- selected" : "");
+  }
+  out += "\nSelected run's GNC steps\n";
+  line("%-34s %.3e\n", "Initial mu (first run)", initial_mu);
   line("  %4s %11s %18s %8s %8s %5s %9s %s\n", "iter", "mu", "surrogate",
        "w = 0", "w = 1", "rank", "time [s]", "solve");
   for (size_t t = 0; t < history.size(); ++t) {
@@ -545,9 +638,11 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   line("%-34s %s\n", "Final weights binary", weights_binary ? "yes" : "no");
   line("%-34s %d accepted, %d rejected\n", "Measurements", num_inliers,
        num_outliers);
+  line("%-34s %d\n", "Consistency rounds", consistency_rounds);
   line("%-34s %d rejected with f_k <= c^2, %d accepted with f_k > c^2\n",
        "Consistency at the result", num_rejected_within_threshold,
        num_accepted_beyond_threshold);
+  line("%-34s %d\n", "Sparsity pattern rebuilds", pattern_rebuilds);
   if (status == Status::kInlierGraphDisconnected) {
     line("\n%-34s %s\n", "Status", StatusString().c_str());
     line("%-34s %s\n", "", message.c_str());

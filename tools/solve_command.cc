@@ -1,13 +1,16 @@
 // `ceres_sesync solve GRAPH.g2o`: SE-Sync with certification.
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/internal/json_writer.h"
+#include "ceres_sesync/robust_solver.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "gflags/gflags.h"
 #include "tools/commands.h"
+#include "tools/robust_output.h"
 
 DEFINE_string(tum, "", "solve: also write the poses as a TUM trajectory.");
 DEFINE_string(init, "chordal",
@@ -27,6 +30,25 @@ DEFINE_double(
     ceres_sesync::SolverOptions().relative_preconditioned_gradient_tolerance,
     "solve: relative preconditioned gradient tolerance of the "
     "local solver.");
+
+DEFINE_bool(robust, false,
+            "solve: outlier-robust solve (GNC with truncated least squares "
+            "around SE-Sync); certified and the exit code then refer to the "
+            "problem restricted to the accepted edges.");
+DEFINE_double(inlier_threshold, 0,
+              "solve --robust: TLS threshold c^2 on each measurement's term "
+              "of the objective (0: the --inlier_probability quantile of "
+              "chi^2 with d(d+1)/2 degrees of freedom).");
+DEFINE_double(inlier_probability,
+              ceres_sesync::RobustSolverOptions().inlier_probability,
+              "solve --robust: chi-square probability of the default "
+              "threshold.");
+DEFINE_string(known_inliers, "odometry",
+              "solve --robust: measurements kept at weight 1: odometry "
+              "(between consecutive poses) | none.");
+DEFINE_string(edge_report, "",
+              "solve --robust: write the per-edge verdicts (weight, inlier, "
+              "residuals) to this CSV file.");
 
 namespace ceres_sesync::tools {
 
@@ -85,6 +107,28 @@ int RunSolve(const Args& args) {
     return kUsageOrInputError;
   }
   options.relative_preconditioned_gradient_tolerance = FLAGS_gradient_tolerance;
+  RobustSolverOptions robust_options;
+  robust_options.inlier_threshold = FLAGS_inlier_threshold;
+  robust_options.inlier_probability = FLAGS_inlier_probability;
+  if (!ParseKnownInliers(FLAGS_known_inliers, &robust_options.known_inliers)) {
+    std::fprintf(stderr, "ceres_sesync solve: unknown --known_inliers '%s'\n",
+                 FLAGS_known_inliers.c_str());
+    return kUsageOrInputError;
+  }
+  for (const char* flag : {"inlier_threshold", "inlier_probability",
+                           "known_inliers", "edge_report"}) {
+    if (!FLAGS_robust &&
+        !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) {
+      std::fprintf(stderr, "ceres_sesync solve: --%s needs --robust\n", flag);
+      return kUsageOrInputError;
+    }
+  }
+  if (FLAGS_robust && !std::isfinite(InlierThreshold(robust_options, 2))) {
+    std::fprintf(stderr,
+                 "ceres_sesync solve: --inlier_threshold must be finite and "
+                 "--inlier_probability in (0, 1)\n");
+    return kUsageOrInputError;
+  }
 
   const std::string& path = args[0];
   PoseGraph graph;
@@ -103,12 +147,30 @@ int RunSolve(const Args& args) {
     return kUsageOrInputError;
   }
   SolverSummary summary;
-  const Poses poses = Solve(graph, options, &summary);
-  std::cout << summary.FullReport() << std::flush;
-  if (summary.status == SolverSummary::Status::kInvalidInput) {
-    std::fprintf(stderr, "ceres_sesync solve: %s: %s\n", path.c_str(),
-                 summary.message.c_str());
-    return kUsageOrInputError;
+  RobustSolverSummary robust;
+  Poses poses;
+  if (FLAGS_robust) {
+    robust_options.solver_options = options;
+    poses = SolveRobust(graph, robust_options, &robust);
+    summary = robust.inlier_summary;  // The problem of the accepted edges.
+    std::cout << robust.FullReport() << std::flush;
+  } else {
+    poses = Solve(graph, options, &summary);
+    std::cout << summary.FullReport() << std::flush;
+  }
+  // Disconnected accepted edges: ran, not certified (exit 1), no inlier
+  // problem was solved.
+  const bool disconnected =
+      FLAGS_robust &&
+      robust.status == RobustSolverSummary::Status::kInlierGraphDisconnected;
+  const bool invalid =
+      FLAGS_robust ? robust.status == RobustSolverSummary::Status::kInvalidInput
+                   : summary.status == SolverSummary::Status::kInvalidInput;
+  if (invalid || disconnected) {
+    std::fprintf(
+        stderr, "ceres_sesync solve: %s: %s\n", path.c_str(),
+        FLAGS_robust ? robust.message.c_str() : summary.message.c_str());
+    if (invalid) return kUsageOrInputError;
   }
   if (!FLAGS_output.empty() &&
       !WriteG2oPoses(FLAGS_output, graph, poses, &error)) {
@@ -116,6 +178,11 @@ int RunSolve(const Args& args) {
     return kUsageOrInputError;
   }
   if (!FLAGS_tum.empty() && !WriteTumFile(FLAGS_tum, graph, poses, &error)) {
+    std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  if (!FLAGS_edge_report.empty() &&
+      !WriteEdgeReport(FLAGS_edge_report, robust, &error)) {
     std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
     return kUsageOrInputError;
   }
@@ -139,7 +206,8 @@ int RunSolve(const Args& args) {
     json.Bool("certified", summary.certified());
     json.Bool("relaxation_exact", summary.relaxation_exact);
     json.Int("rank", summary.final_rank);
-    json.String("status", summary.StatusString());
+    json.String("status",
+                disconnected ? robust.StatusString() : summary.StatusString());
     json.Int("iterations", summary.iterations);
     json.Int("hessian_vector_products", summary.hessian_vector_products);
     json.BeginObject("proof");
@@ -157,6 +225,7 @@ int RunSolve(const Args& args) {
     json.Number("rounding", summary.rounding_time_s);
     json.EndObject();
     json.Number("total_time_s", summary.total_time_s);
+    if (FLAGS_robust) AddRobustJson(robust, &json);
     if (!json.WriteToFile(FLAGS_json, &error)) {
       std::fprintf(stderr, "ceres_sesync solve: %s\n", error.c_str());
       return kUsageOrInputError;
