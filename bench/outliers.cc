@@ -543,42 +543,55 @@ int Main() {
     }
   }
 
-  // Breakdown: the largest fraction up to which every seed succeeds.
-  md << "\n## Holds to (largest fraction with every seed successful at it "
-        "and below; '-' none)\n\n| dataset | mode |";
-  for (const std::string& method : methods) md << " " << method << " |";
-  md << "\n|---|---|";
-  for (size_t q = 0; q < methods.size(); ++q) md << "---|";
-  md << "\n";
-  for (const Dataset& data : datasets) {
-    for (const std::string mode : {"random", "clustered"}) {
-      std::vector<double> fractions;
-      for (const auto& [g_mode, f] : grid) {
-        if (g_mode == mode) fractions.push_back(f);
-      }
-      if (fractions.empty()) continue;
-      std::sort(fractions.begin(), fractions.end());
-      md << "| " << data.name << " | " << mode << " |";
-      for (const std::string& method : methods) {
-        double holds = NAN;
-        for (double f : fractions) {
-          const auto& runs = cells[{data.name, mode, f, method}];
-          const bool all =
-              !runs.empty() &&
-              std::all_of(runs.begin(), runs.end(), [](const Row* row) {
-                return row->ok && Success(row->result);
-              });
-          if (!all) break;
-          holds = f;
+  // Breakdown: the largest fraction up to which every seed succeeds, by
+  // the goal and by precision and recall alone (M-estimators never recover
+  // the clean optimum exactly, so the goal is out of their reach by design).
+  auto holds_table = [&](const char* title, auto success) {
+    md << "\n## " << title << "\n\n| dataset | mode |";
+    for (const std::string& method : methods) md << " " << method << " |";
+    md << "\n|---|---|";
+    for (size_t q = 0; q < methods.size(); ++q) md << "---|";
+    md << "\n";
+    for (const Dataset& data : datasets) {
+      for (const std::string mode : {"random", "clustered"}) {
+        std::vector<double> fractions;
+        for (const auto& [g_mode, f] : grid) {
+          if (g_mode == mode) fractions.push_back(f);
         }
-        md << " "
-           << (std::isnan(holds) ? std::string("-")
-                                 : Fmt("%.0f%%", 100 * holds))
-           << " |";
+        if (fractions.empty()) continue;
+        std::sort(fractions.begin(), fractions.end());
+        md << "| " << data.name << " | " << mode << " |";
+        for (const std::string& method : methods) {
+          double holds = NAN;
+          for (double f : fractions) {
+            const auto& runs = cells[{data.name, mode, f, method}];
+            const bool all =
+                !runs.empty() &&
+                std::all_of(runs.begin(), runs.end(), [&](const Row* row) {
+                  return row->ok && success(row->result);
+                });
+            if (!all) break;
+            holds = f;
+          }
+          md << " "
+             << (std::isnan(holds) ? std::string("-")
+                                   : Fmt("%.0f%%", 100 * holds))
+             << " |";
+        }
+        md << "\n";
       }
-      md << "\n";
     }
-  }
+  };
+  holds_table(
+      "Holds to: the goal (largest fraction with every seed successful at "
+      "it and below; '-' none)",
+      Success);
+  holds_table(
+      "Holds to: precision and recall >= 0.99 only (clean objective not "
+      "required)",
+      [](const RunResult& r) {
+        return r.precision >= 0.99 && r.recall >= 0.99;
+      });
   const std::string text = md.str();
   std::printf("\n%s", text.c_str());
   std::ofstream(FLAGS_out_dir + "/" + FLAGS_out_name + ".md") << text;

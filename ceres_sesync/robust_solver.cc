@@ -540,6 +540,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.iterations = best.record.iterations;
   s.consistency_rounds = best.record.consistency_rounds;
   s.history = std::move(best.history);
+  if (!s.history.empty()) s.initial_mu = s.history[0].mu;
   s.weights_binary = best.weights_binary;
   s.message = best.message;
   s.inlier_summary = best.inlier_summary;
@@ -624,7 +625,7 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
          static_cast<int>(q) == selected_run ? "  <- selected" : "");
   }
   out += "\nSelected run's GNC steps\n";
-  line("%-34s %.3e\n", "Initial mu (first run)", initial_mu);
+  line("%-34s %.3e\n", "Initial mu", initial_mu);
   line("  %4s %11s %18s %8s %8s %5s %9s %s\n", "iter", "mu", "surrogate",
        "w = 0", "w = 1", "rank", "time [s]", "solve");
   for (size_t t = 0; t < history.size(); ++t) {

@@ -78,7 +78,7 @@ struct RobustSolverOptions {
   // d(d+1)/2 degrees of freedom (2D: 3, 3D: 6).
   double inlier_threshold = 0;
   // The probability that an inlier's f_k is below c^2 under the noise model,
-  // in (0, 1). 1 - 1e-6 gives c^2 = 30.66 (2D) and 35.89 (3D). Real
+  // in (0, 1). 1 - 1e-6 gives c^2 = 30.66 (2D) and 38.26 (3D). Real
   // datasets' precisions are only roughly calibrated: at the clean optimum
   // of cubicle the largest f_k is 26.3 (the 3D 0.999-quantile is 22.5), and
   // manhattan's rotation terms reach 27 with heavy tails, so that its TLS
@@ -114,9 +114,9 @@ struct RobustSolverOptions {
   // solve is the inlier problem and continues to max_rank if it needs to.
   int initial_max_rank = 0;
 
-  // GNC schedule (Yang et al. 2020): mu_0 = c^2 / (2 max f_k - c^2) from the
-  // residuals of the all-inlier solve, then mu <- mu_step mu after each
-  // weight update.
+  // GNC schedule (Yang et al. 2020): mu_0 = g^2 / (2 max f_k - g^2) from the
+  // residuals of the all-inlier solve (g^2: the run's GNC threshold), then
+  // mu <- mu_step mu after each weight update.
   double mu_step = 1.4;
   // Largest number of weight updates (each followed by a weighted solve).
   int max_iterations = 100;
@@ -132,9 +132,9 @@ struct RobustSolverOptions {
   // set's problem, replace it and solve again, at most this many times (0:
   // off). Every round lowers the TLS cost, so the result is a fixed point
   // whenever fewer rounds suffice (then num_rejected_within_threshold and
-  // num_accepted_beyond_threshold are 0). Measured: GNC rejected 3 true
-  // closures of manhattan with 30% random outliers whose f_k at its result
-  // were below c^2.
+  // num_accepted_beyond_threshold are 0). Measured: GNC at c^2 = 100
+  // rejected 3 true closures of manhattan (30% random outliers) whose f_k at
+  // its result were below c^2; one round re-admitted them.
   int max_consistency_rounds = 10;
 
   enum class KnownInliers {
@@ -217,8 +217,8 @@ struct RobustSolverSummary {
   std::vector<Run> runs;
   // Index of the run whose result is returned (lowest TLS cost).
   int selected_run = -1;
-  // mu_0 of the first run (0 if no update was needed: every f_k <= c^2 at
-  // the first solve).
+  // mu_0 of the selected run (0 if no update was needed: every f_k <= c^2
+  // at the first solve).
   double initial_mu = 0;
   // The selected run's weight updates (0: the all-inlier solve already
   // fit) and their steps.
