@@ -66,7 +66,8 @@ double Seconds(double begin) { return CpuNow() - begin; }
 // The certificate matrix with Lambda = 0 and c = 1 (lower triangle), as
 // CertificateMatrix assembles it.
 SparseMatrix CertificateLikeMatrix(const internal::SESyncProblem& problem) {
-  const int n = problem.num_poses(), d = problem.dimension(), t0 = n - 1;
+  const int n = problem.num_rotations(), d = problem.dimension(),
+            t0 = problem.num_translations() - 1;  // Pose graphs only.
   std::vector<Eigen::Triplet<double>> triplets;
   const SparseMatrix& L = problem.Lbar();
   const SparseMatrix& V = problem.Vbar();
@@ -107,7 +108,8 @@ SparseMatrix CertificateLikeMatrix(const internal::SESyncProblem& problem) {
 // CertificateMatrix's ordering: the vertex ordering, each vertex expanded
 // into its translation (none for vertex 0) and d rotation unknowns.
 std::vector<int> BlockOrdering(const internal::SESyncProblem& problem) {
-  const int n = problem.num_poses(), d = problem.dimension(), t0 = n - 1;
+  const int d = problem.dimension();
+  const int t0 = problem.num_translations() - 1;  // Pose graphs only.
   std::vector<int> ordering;
   for (int v : problem.vertex_ordering()) {
     if (v > 0) ordering.push_back(v - 1);

@@ -9,6 +9,7 @@
 #include "Eigen/Geometry"
 #include "Eigen/SVD"
 #include "ceres/autodiff_cost_function.h"
+#include "ceres/loss_function.h"
 #include "ceres/manifold.h"
 #include "ceres/types.h"
 
@@ -215,6 +216,20 @@ Eigen::Matrix3d ProjectToSO3(const Eigen::Matrix3d& M) {
   return svd.matrixU() * D * svd.matrixV().transpose();
 }
 
+// The loss of `loss` (owned by the problem), or null for least squares.
+ceres::LossFunction* MakeLoss(const CeresRobustLoss& loss) {
+  const double a = std::sqrt(loss.threshold);
+  switch (loss.type) {
+    case CeresRobustLoss::Type::kNone:
+      return nullptr;
+    case CeresRobustLoss::Type::kHuber:
+      return new ceres::HuberLoss(a);
+    case CeresRobustLoss::Type::kCauchy:
+      return new ceres::CauchyLoss(a);
+  }
+  return nullptr;
+}
+
 const char* MethodName(const ceres::Solver::Summary& s) {
   if (s.trust_region_strategy_type == ceres::DOGLEG) {
     return s.dogleg_type == ceres::TRADITIONAL_DOGLEG ? "PDL-GN" : "dogleg";
@@ -305,7 +320,8 @@ Poses CeresPoseBlocks::ToPoses() const {
 }
 
 bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
-                       ceres::Problem* problem, std::string* error) {
+                       ceres::Problem* problem, std::string* error,
+                       const CeresRobustLoss& loss) {
   auto fail = [&](const std::string& message) {
     if (error) *error = message;
     return false;
@@ -323,6 +339,10 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
     return fail("parameter blocks do not match the graph's size");
   }
   if (graph.fixed_pose >= n) return fail("fixed_pose is out of range");
+  if (loss.type != CeresRobustLoss::Type::kNone &&
+      !(loss.threshold > 0 && std::isfinite(loss.threshold))) {
+    return fail("a robust loss needs a positive finite threshold");
+  }
   for (int i = 0; i < n; ++i) {
     problem->AddParameterBlock(blocks->translation(i), d);
     if (d == 2) {
@@ -344,7 +364,7 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
       cost = new ceres::AutoDiffCostFunction<Pose3Residual, 12, 3, 4, 3, 4>(
           new Pose3Residual(m));
     }
-    problem->AddResidualBlock(cost, nullptr, blocks->translation(m.i),
+    problem->AddResidualBlock(cost, MakeLoss(loss), blocks->translation(m.i),
                               blocks->rotation(m.i), blocks->translation(m.j),
                               blocks->rotation(m.j));
   }
@@ -458,7 +478,9 @@ bool SolveWithCeres(const PoseGraph& graph, const Solution& initial,
     return fail("invalid initial poses or landmarks: " + why);
   }
   ceres::Problem problem;
-  if (!BuildCeresProblem(graph, &blocks, &problem, &why)) return fail(why);
+  if (!BuildCeresProblem(graph, &blocks, &problem, &why, options.loss)) {
+    return fail(why);
+  }
 
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, &problem, &ceres_summary);
@@ -466,15 +488,21 @@ bool SolveWithCeres(const PoseGraph& graph, const Solution& initial,
       !ceres_summary.IsSolutionUsable()) {
     return fail("Ceres failed: " + ceres_summary.message);
   }
-  if (result) *result = Solution{blocks.ToPoses(), blocks.ToLandmarks()};
+  Solution solution{blocks.ToPoses(), blocks.ToLandmarks()};
   if (summary) {
-    summary->initial_objective = 2 * ceres_summary.initial_cost;
-    summary->final_objective = 2 * ceres_summary.final_cost;
+    summary->initial_robust_objective = 2 * ceres_summary.initial_cost;
+    summary->final_robust_objective = 2 * ceres_summary.final_cost;
+    const bool robust = options.loss.type != CeresRobustLoss::Type::kNone;
+    summary->initial_objective = robust ? EvaluateObjective(graph, initial)
+                                        : summary->initial_robust_objective;
+    summary->final_objective = robust ? EvaluateObjective(graph, solution)
+                                      : summary->final_robust_objective;
     summary->iterations = ceres_summary.num_successful_steps +
                           ceres_summary.num_unsuccessful_steps;
     summary->time_s = ceres_summary.total_time_in_seconds;
     summary->solver_summary = std::move(ceres_summary);
   }
+  if (result) *result = std::move(solution);
   return true;
 }
 

@@ -36,6 +36,15 @@
 // Priors that leave a rotation free (e.g. position priors at one point
 // only) leave the problem rank-deficient in that direction; the trust
 // region's regularization copes, and the result is one of the minimizers.
+//
+// Robust losses (CeresRobustLoss): each measurement's residual block gets a
+// ceres::LossFunction on its squared norm s = f_k, the measurement's term of
+// eq. (12). With the scale a = sqrt(threshold) (Ceres's parameter),
+//   Huber:  rho(s) = s for s <= a^2, 2 a sqrt(s) - a^2 beyond;
+//   Cauchy: rho(s) = a^2 log(1 + s / a^2),
+// so threshold = c^2, the TLS threshold of robust_solver.h, compares the
+// losses with the robust solve on the same scale. Landmark measurements and
+// priors get no loss.
 
 #ifndef CERES_SESYNC_CERES_BASELINE_H_
 #define CERES_SESYNC_CERES_BASELINE_H_
@@ -48,6 +57,17 @@
 #include "ceres_sesync/pose_graph.h"
 
 namespace ceres_sesync {
+
+struct CeresRobustLoss {
+  enum class Type {
+    kNone,    // Least squares (no loss function).
+    kHuber,   // ceres::HuberLoss(sqrt(threshold)).
+    kCauchy,  // ceres::CauchyLoss(sqrt(threshold)).
+  };
+  Type type = Type::kNone;
+  // a^2 on f_k (> 0 with a loss): where the loss leaves the quadratic.
+  double threshold = 0;
+};
 
 struct CeresBaselineOptions {
   enum class Method {
@@ -76,6 +96,8 @@ struct CeresBaselineOptions {
   // Log per-iteration progress to stdout (Ceres's minimizer_progress_to_
   // stdout).
   bool verbose = false;
+  // Robust loss on every measurement (default: none, least squares).
+  CeresRobustLoss loss;
 };
 
 struct CeresBaselineSummary {
@@ -86,6 +108,10 @@ struct CeresBaselineSummary {
   double initial_objective = 0;
   // F at the returned poses (and landmarks), on the scale of eq. (12).
   double final_objective = 0;
+  // What Ceres minimized, 2 * its cost: sum_k rho(f_k) with a robust loss,
+  // else F (equal to the objectives above).
+  double initial_robust_objective = 0;
+  double final_robust_objective = 0;
   // Number of trust-region iterations (successful + unsuccessful steps).
   int iterations = 0;
   // Wall time of ceres::Solve, in seconds.
@@ -136,11 +162,13 @@ struct CeresPoseBlocks {
 // (which must outlive `problem` and have graph.num_poses poses and
 // graph.num_landmarks landmarks), sets the quaternion manifolds (3D) and
 // holds the gauge constant (see "Gauge" above). `problem` should be empty and
-// use the default ownership options. Returns false (problem untouched) if the
-// graph fails ValidatePoseGraph (landmarks and priors allowed) or the sizes
-// disagree.
+// use the default ownership options. `loss` (default: none) puts a robust
+// loss on every pose-pose measurement. Returns false (problem untouched) if
+// the graph fails ValidatePoseGraph (landmarks and priors allowed), the sizes
+// disagree or a loss has no positive finite threshold.
 bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
-                       ceres::Problem* problem, std::string* error);
+                       ceres::Problem* problem, std::string* error,
+                       const CeresRobustLoss& loss = {});
 
 // Minimizes F with Ceres from `initial` (one pose per pose and one position
 // per landmark of `graph`). The gauge (see above) stays at its initial

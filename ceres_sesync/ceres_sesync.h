@@ -13,6 +13,10 @@
 //                             trajectories.
 //   sesync_solver.h           Solve(): SE-Sync, certifiably correct pose-graph
 //                             optimization (SolverOptions, SolverSummary).
+//   robust_solver.h           SolveRobust(): outlier-robust GNC with truncated
+//                             least squares around SE-Sync, per-edge
+//                             verdicts, the accepted edges' problem
+//                             certified.
 //   certification.h           Certify(): a global-optimality certificate or a
 //                             suboptimality bound for ANY solution, e.g. one
 //                             computed by Ceres.
@@ -30,6 +34,8 @@
 //                             with loop closures on revisits.
 //   landmark_generator.h      A synthetic landmark-SLAM benchmark (Manhattan
 //                             walk, random landmarks, GPS / start priors).
+//   outlier_generator.h       Wrong loop closures (random or clustered) for
+//                             outlier experiments.
 //   langevin.h                The isotropic Langevin / von Mises noise
 //                             samplers used by the generators.
 //   stiefel_manifold.h        St(d, r) and St(d, r)^n: free functions and
@@ -52,9 +58,11 @@
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/langevin.h"
+#include "ceres_sesync/outlier_generator.h"
 #include "ceres_sesync/pose_conversions.h"
 #include "ceres_sesync/pose_graph.h"
 #include "ceres_sesync/riemannian_trust_region.h"
+#include "ceres_sesync/robust_solver.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "ceres_sesync/stiefel_manifold.h"
 

@@ -3,15 +3,17 @@
 # bench/results/.
 #
 #   scripts/bench.sh           full run (~40-60 min on 2 cores, plus 1-3 h
-#                              for the scaling bench up to 10^6 poses):
+#                              for the scaling bench up to 10^6 poses and
+#                              several hours for the outlier bench):
 #                              bench over every dataset (3 repeats), peak
 #                              memory of SE-Sync on the largest datasets, the
 #                              cube sweep (5 realizations) and scaling run,
-#                              the scaling bench (city 2D/3D, cube), plots.
+#                              the scaling bench (city 2D/3D, cube), the
+#                              outlier bench (bench/outliers.cc), plots.
 #   scripts/bench.sh --quick   smoke run (seconds): bench --quick,
-#                              cube_sweep --quick and scaling --quick into
-#                              $BUILD_DIR/bench-quick (bench/results is left
-#                              alone).
+#                              cube_sweep --quick, scaling --quick and
+#                              outliers --quick into $BUILD_DIR/bench-quick
+#                              (bench/results is left alone).
 #
 # Environment: BUILD_DIR (default build/), BENCH_OUT (output directory;
 # default bench/results, or $BUILD_DIR/bench-quick with --quick).
@@ -27,7 +29,7 @@ fi
 "$root/scripts/install-deps.sh"
 build=${BUILD_DIR:-$root/build}
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j"$(nproc)" --target bench cube_sweep scaling -- \
+cmake --build "$build" -j"$(nproc)" --target bench cube_sweep scaling outliers -- \
   --no-print-directory >/dev/null
 bin=$build/bench
 py=/usr/bin/python3  # Debian's, with python3-matplotlib.
@@ -49,6 +51,10 @@ if [ $quick -eq 1 ]; then
   "$py" "$root/bench/plot_cube_sweep.py" "$out"
   "$bin/scaling" --quick --out_dir "$out" >"$out/scaling.txt"
   "$py" "$root/bench/plot_scaling.py" "$out"
+  if [ -d "$data" ]; then
+    "$bin/outliers" --quick --out_dir "$out" >"$out/outliers.txt"
+    "$py" "$root/bench/plot_outliers.py" "$out" >/dev/null
+  fi
   echo "bench.sh --quick: outputs in $out ($(($(date +%s) - start)) s)"
   exit 0
 fi
@@ -85,9 +91,20 @@ done
 #    SE-Sync vs Ceres PDL-GN/LM from chordal, one process per run.
 "$bin/scaling" --ceres_max_time 600 --out_dir "$out" | tee "$out/scaling.txt"
 
-# 5) Plots.
+# 5) Outliers (issue #13): every dataset, random outliers at 10..90% and
+#    clustered at 10..50% of the loop closures, 3 seeds, plain SE-Sync, the
+#    robust solve and Ceres LM with Huber/Cauchy; then manhattan again with
+#    the threshold its precisions need (bench/README.md).
+"$bin/outliers" --out_dir "$out" | tee "$out/outliers.txt"
+"$bin/outliers" --datasets manhattan --dataset_thresholds manhattan=100 \
+  --out_name outliers_manhattan_c100 --out_dir "$out" \
+  | tee "$out/outliers_manhattan_c100.txt"
+
+# 6) Plots.
 "$py" "$root/bench/plot_cube_sweep.py" "$out"
 "$py" "$root/bench/plot_scaling.py" "$out"
+"$py" "$root/bench/plot_outliers.py" "$out"
+"$py" "$root/bench/plot_outliers.py" "$out" --name outliers_manhattan_c100
 "$py" "$root/bench/plot_trajectory.py" "$poses" "$out" --compare manhattan
 "$py" "$root/bench/plot_trajectory.py" "$poses" "$out" --datasets "" \
   --compare torus3D >/dev/null

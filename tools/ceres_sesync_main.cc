@@ -87,6 +87,11 @@ const std::vector<Command>& Commands() {
         {"num_threads"},
         {"proof_arithmetic"},
         {"progress"},
+        {"robust"},
+        {"inlier_threshold"},
+        {"inlier_probability"},
+        {"known_inliers"},
+        {"edge_report"},
         {"verbose"}}},
       {"certify",
        ceres_sesync::tools::RunCertify,
@@ -109,8 +114,8 @@ const std::vector<Command>& Commands() {
         {"verbose"}}},
       {"generate",
        ceres_sesync::tools::RunGenerate,
-       "cube|city|landmarks",
-       "write a synthetic pose graph (cube, city, landmarks)",
+       "cube|city|landmarks|outliers",
+       "write a synthetic pose graph (cube, city, landmarks, outliers)",
        "'generate cube' writes the synthetic cube benchmark of SE-Sync's "
        "Section 6.1: a boustrophedon path through an s x s x s lattice (s x s "
        "in 2D) with odometry, random loop closures and noise of the paper's "
@@ -119,7 +124,10 @@ const std::vector<Command>& Commands() {
        "places. 'generate landmarks' writes a Manhattan walk observing random "
        "point landmarks within a sensor range, with optional GPS-like "
        "position priors and a start prior (--preset victoria: many landmarks "
-       "per pose).",
+       "per pose). 'generate outliers GRAPH.g2o' writes a copy of a graph "
+       "with wrong loop closures appended (--fraction of all its loop "
+       "closures; random, or clustered: groups of mutually consistent wrong "
+       "closures) and the indices of what it added.",
        {{"output", "Write the generated graph to this g2o file (required)."},
         {"side"},
         {"poses"},
@@ -149,7 +157,11 @@ const std::vector<Command>& Commands() {
         {"start_prior"},
         {"start_prior_kappa"},
         {"start_prior_tau"},
-        {"noiseless"}}},
+        {"noiseless"},
+        {"fraction"},
+        {"mode"},
+        {"cluster_size"},
+        {"outlier_indices"}}},
   };
   return commands;
 }

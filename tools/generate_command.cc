@@ -2,15 +2,20 @@
 // cube (or 2D grid) of SE-Sync's Section 6.1 (ceres_sesync/cube_generator.h)
 // or a large Manhattan-style city walk (ceres_sesync/city_generator.h).
 // `generate landmarks ...` is in generate_landmarks_command.cc.
+// `ceres_sesync generate outliers GRAPH.g2o ...`: a copy of a graph with wrong
+// loop closures appended (ceres_sesync/outlier_generator.h).
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/internal/file_util.h"
+#include "ceres_sesync/outlier_generator.h"
 #include "ceres_sesync/pose_graph.h"
 #include "gflags/gflags.h"
 #include "tools/commands.h"
@@ -44,6 +49,20 @@ DEFINE_string(vertices, "odometry",
               "along the path, like recorded datasets), 'ground_truth', or "
               "'none'.");
 
+DEFINE_double(fraction, -1,
+              "generate outliers: fraction of the output's loop closures that "
+              "are wrong, in [0, 1) (required).");
+DEFINE_string(mode, "random",
+              "generate outliers: random (random pose pairs and relative "
+              "poses) | clustered (groups of mutually consistent wrong "
+              "closures: perceptual aliasing).");
+DEFINE_int32(cluster_size, 10,
+             "generate outliers --mode clustered: wrong closures per group.");
+DEFINE_string(outlier_indices, "",
+              "generate outliers: where to write the 0-based indices of the "
+              "added measurements, one per line, in the order of the "
+              "output's EDGE lines (default: OUTPUT.outliers.txt).");
+
 namespace ceres_sesync::tools {
 
 namespace {
@@ -56,7 +75,10 @@ constexpr char kUsage[] =
     "       ceres_sesync generate city --poses N [--dimension 2|3] "
     "[--loop_closure_probability P] [--kappa K] [--tau T] [--seed N] "
     "--output FILE.g2o [--ground_truth FILE.g2o] "
-    "[--vertices odometry|ground_truth|none]\n";
+    "[--vertices odometry|ground_truth|none]\n"
+    "       ceres_sesync generate outliers GRAPH.g2o --fraction F "
+    "[--mode random|clustered] [--cluster_size K] [--seed N] --output "
+    "FILE.g2o [--outlier_indices FILE.txt]\n";
 
 // Whether `flag` was given on the command line.
 bool IsSet(const char* flag) {
@@ -80,16 +102,98 @@ Poses DeadReckoning(const PoseGraph& graph) {
   return poses;
 }
 
+// `generate outliers GRAPH.g2o`: the graph plus wrong loop closures.
+int RunGenerateOutliers(const Args& args) {
+  if (args.size() != 2) {
+    return UsageError(args.size() < 2
+                          ? "missing the input GRAPH.g2o"
+                          : "unexpected argument '" + args[2] + "'");
+  }
+  for (const char* flag :
+       {"side", "poses", "dimension", "loop_closure_probability",
+        "loop_closure_radius", "kappa", "tau", "ground_truth", "vertices"}) {
+    if (IsSet(flag)) {
+      return UsageError(std::string("--") + flag +
+                        " is not an option of 'generate outliers'");
+    }
+  }
+  if (!IsSet("fraction")) return UsageError("--fraction F is required");
+  if (!(FLAGS_fraction >= 0 && FLAGS_fraction < 1)) {
+    return UsageError("--fraction must be in [0, 1)");
+  }
+  if (FLAGS_output.empty()) return UsageError("--output FILE.g2o is required");
+  OutlierOptions options;
+  options.fraction = FLAGS_fraction;
+  options.cluster_size = FLAGS_cluster_size;
+  options.seed = FLAGS_seed;
+  if (FLAGS_mode == "random") {
+    options.mode = OutlierOptions::Mode::kRandom;
+  } else if (FLAGS_mode == "clustered") {
+    options.mode = OutlierOptions::Mode::kClustered;
+  } else {
+    return UsageError("--mode must be random or clustered");
+  }
+  if (IsSet("cluster_size") &&
+      options.mode != OutlierOptions::Mode::kClustered) {
+    return UsageError("--cluster_size is for --mode clustered");
+  }
+  PoseGraph graph, corrupted;
+  std::string error;
+  if (!ReadG2oFile(args[1], {}, &graph, &error)) {
+    std::fprintf(stderr, "ceres_sesync generate: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  std::vector<int> added;
+  if (!AddOutliers(graph, options, &corrupted, &added, &error)) {
+    std::fprintf(stderr, "ceres_sesync generate: %s: %s\n", args[1].c_str(),
+                 error.c_str());
+    return kUsageOrInputError;
+  }
+  const std::string indices_path = FLAGS_outlier_indices.empty()
+                                       ? FLAGS_output + ".outliers.txt"
+                                       : FLAGS_outlier_indices;
+  std::string indices;
+  for (int k : added) indices += std::to_string(k) + "\n";
+  if (!internal::WriteFileAtomically(indices_path, indices, &error)) {
+    std::fprintf(stderr, "ceres_sesync generate: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  if (!WriteG2oFile(FLAGS_output, corrupted, corrupted.initial_poses, &error)) {
+    std::remove(indices_path.c_str());  // No partial output.
+    std::fprintf(stderr, "ceres_sesync generate: %s\n", error.c_str());
+    return kUsageOrInputError;
+  }
+  const int m = static_cast<int>(graph.measurements.size());
+  std::printf(
+      "outliers (%s): %d wrong loop closures appended to the %d measurements "
+      "of %s (fraction %.3g of the loop closures), seed %llu\n"
+      "wrote %s and %s\n",
+      FLAGS_mode.c_str(), static_cast<int>(added.size()), m, args[1].c_str(),
+      options.fraction, static_cast<unsigned long long>(options.seed),
+      FLAGS_output.c_str(), indices_path.c_str());
+  return kSuccess;
+}
+
 }  // namespace
 
 int RunGenerate(const Args& args) {
   if (args.empty()) {
-    return UsageError("missing the model name (cube, city or landmarks)");
+    return UsageError(
+        "missing the model name (cube, city, landmarks or outliers)");
   }
   if (args[0] == "landmarks") return RunGenerateLandmarks(args);
   const std::string& model = args[0];
+  if (model == "outliers") return RunGenerateOutliers(args);
   if (model != "cube" && model != "city") {
-    return UsageError("unknown model '" + model + "' (cube, city or landmarks)");
+    return UsageError("unknown model '" + model +
+                      "' (cube, city, landmarks or outliers)");
+  }
+  for (const char* flag :
+       {"fraction", "mode", "cluster_size", "outlier_indices"}) {
+    if (IsSet(flag)) {
+      return UsageError(std::string("--") + flag +
+                        " is for 'generate outliers'");
+    }
   }
   if (args.size() > 1) {
     return UsageError("unexpected argument '" + args[1] + "'");

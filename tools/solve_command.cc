@@ -1,15 +1,18 @@
 // `ceres_sesync solve GRAPH.g2o`: SE-Sync with certification.
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
 #include "ceres_sesync/component_solver.h"
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/internal/json_writer.h"
+#include "ceres_sesync/robust_solver.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "gflags/gflags.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
+#include "tools/robust_output.h"
 
 DEFINE_string(tum, "", "Also write the poses as a TUM trajectory.");
 DEFINE_string(init, "chordal",
@@ -35,12 +38,33 @@ DEFINE_bool(components, false,
             "and --json list the components. Without it a disconnected graph "
             "is an input error.");
 
+DEFINE_bool(robust, false,
+            "solve: outlier-robust solve (GNC with truncated least squares "
+            "around SE-Sync); certified and the exit code then refer to the "
+            "problem restricted to the accepted edges.");
+DEFINE_double(inlier_threshold, 0,
+              "solve --robust: TLS threshold c^2 on each measurement's term "
+              "of the objective (0: the --inlier_probability quantile of "
+              "chi^2 with d(d+1)/2 degrees of freedom).");
+DEFINE_double(inlier_probability,
+              ceres_sesync::RobustSolverOptions().inlier_probability,
+              "solve --robust: chi-square probability of the default "
+              "threshold.");
+DEFINE_string(known_inliers, "odometry",
+              "solve --robust: measurements kept at weight 1: odometry "
+              "(between consecutive poses) | none.");
+DEFINE_string(edge_report, "",
+              "solve --robust: write the per-edge verdicts (weight, inlier, "
+              "residuals) to this CSV file.");
+
 namespace ceres_sesync::tools {
 namespace {
 
 // The fields of a SolverSummary in the --json file (the whole solve, or one
-// component of --components).
-void AddSummary(const SolverSummary& summary, internal::JsonWriter* json) {
+// component of --components). `status` (if not empty) replaces the
+// summary's status.
+void AddSummary(const SolverSummary& summary, internal::JsonWriter* json,
+                const std::string& status = "") {
   json->Int("num_poses", summary.num_poses);
   json->Int("num_measurements", summary.num_measurements);
   json->Int("num_landmarks", summary.num_landmarks);
@@ -61,7 +85,7 @@ void AddSummary(const SolverSummary& summary, internal::JsonWriter* json) {
   json->Bool("certified", summary.certified());
   json->Bool("relaxation_exact", summary.relaxation_exact);
   json->Int("rank", summary.final_rank);
-  json->String("status", summary.StatusString());
+  json->String("status", status.empty() ? summary.StatusString() : status);
   json->Int("iterations", summary.iterations);
   json->Int("hessian_vector_products", summary.hessian_vector_products);
   json->BeginObject("proof");
@@ -162,6 +186,28 @@ int RunSolve(const Args& args) {
                       "'");
   }
   options.relative_preconditioned_gradient_tolerance = FLAGS_gradient_tolerance;
+  RobustSolverOptions robust_options;
+  robust_options.inlier_threshold = FLAGS_inlier_threshold;
+  robust_options.inlier_probability = FLAGS_inlier_probability;
+  if (!ParseKnownInliers(FLAGS_known_inliers, &robust_options.known_inliers)) {
+    std::fprintf(stderr, "ceres_sesync solve: unknown --known_inliers '%s'\n",
+                 FLAGS_known_inliers.c_str());
+    return kUsageOrInputError;
+  }
+  for (const char* flag : {"inlier_threshold", "inlier_probability",
+                           "known_inliers", "edge_report"}) {
+    if (!FLAGS_robust &&
+        !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) {
+      std::fprintf(stderr, "ceres_sesync solve: --%s needs --robust\n", flag);
+      return kUsageOrInputError;
+    }
+  }
+  if (FLAGS_robust && !std::isfinite(InlierThreshold(robust_options, 2))) {
+    std::fprintf(stderr,
+                 "ceres_sesync solve: --inlier_threshold must be finite and "
+                 "--inlier_probability in (0, 1)\n");
+    return kUsageOrInputError;
+  }
 
   const std::string& path = args[0];
   PoseGraph graph;
@@ -179,6 +225,9 @@ int RunSolve(const Args& args) {
     return InputError(path +
                       ": --init vertices, but the file has no VERTEX lines");
   }
+  if (FLAGS_robust && FLAGS_components) {
+    return InputError("--robust and --components cannot be combined");
+  }
   std::unique_ptr<ProgressPrinter> progress = ProgressPrinterFromFlags();
   if (progress) options.progress = progress->Callback();
 
@@ -186,6 +235,7 @@ int RunSolve(const Args& args) {
   bool certified = false;
   internal::JsonWriter json;
   json.String("graph", path);
+  RobustSolverSummary robust;
   if (FLAGS_components) {
     ComponentsSummary summary;
     solution.poses = SolveByComponent(graph, options, &summary);
@@ -196,6 +246,28 @@ int RunSolve(const Args& args) {
     }
     certified = summary.certified();
     AddComponents(graph, summary, &json);
+  } else if (FLAGS_robust) {
+    robust_options.solver_options = options;
+    solution.poses = SolveRobust(graph, robust_options, &robust);
+    if (progress) progress->Finish();
+    std::cout << robust.FullReport() << std::flush;
+    if (robust.status == RobustSolverSummary::Status::kInvalidInput) {
+      return InputError(path + ": " + robust.message);
+    }
+    // Disconnected accepted edges: ran, not certified (exit 1), no inlier
+    // problem was solved.
+    const bool disconnected =
+        robust.status == RobustSolverSummary::Status::kInlierGraphDisconnected;
+    if (disconnected) {
+      std::fprintf(stderr, "ceres_sesync solve: %s: %s\n", path.c_str(),
+                   robust.message.c_str());
+    }
+    // The problem of the accepted edges.
+    const SolverSummary& summary = robust.inlier_summary;
+    certified = summary.certified();
+    AddSummary(summary, &json,
+               disconnected ? robust.StatusString() : std::string());
+    AddRobustJson(robust, &json);
   } else {
     SolverSummary summary;
     Solve(graph, options, &solution, &summary);
@@ -214,6 +286,10 @@ int RunSolve(const Args& args) {
   }
   if (!FLAGS_tum.empty() &&
       !WriteTumFile(FLAGS_tum, graph, solution.poses, &error)) {
+    return InputError(error);
+  }
+  if (!FLAGS_edge_report.empty() &&
+      !WriteEdgeReport(FLAGS_edge_report, robust, &error)) {
     return InputError(error);
   }
   if (!FLAGS_json.empty() && !json.WriteToFile(FLAGS_json, &error)) {

@@ -55,10 +55,38 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
       rotation_size_(problem.dimension() * problem.num_rotations()) {
   CHECK_LE(d_, 3);  // Assemble's row sums.
   const int t0 = translation_size_, d = d_;
+  K_ = BaseMatrix();
+  translation_diagonal_.reserve(t0);
+  for (int j = 0; j < t0; ++j) {
+    // Lower triangle, sorted rows: the diagonal leads its column.
+    const int k = K_.outerIndexPtr()[j];
+    CHECK_EQ(K_.innerIndexPtr()[k], j);
+    translation_diagonal_.push_back(k);
+  }
+  block_entry_.reserve(n_ * d * (d + 1) / 2);
+  for (int i = 0; i < n_; ++i) {
+    for (int b = 0; b < d; ++b) {
+      const int col = t0 + d * i + b;
+      const int* begin = K_.innerIndexPtr() + K_.outerIndexPtr()[col];
+      const int* end = K_.innerIndexPtr() + K_.outerIndexPtr()[col + 1];
+      for (int a = b; a < d; ++a) {
+        const int* pos = std::lower_bound(begin, end, t0 + d * i + a);
+        block_entry_.push_back(static_cast<int>(pos - K_.innerIndexPtr()));
+      }
+    }
+  }
+  SetData(K_);
+  ordering_ = BlockOrdering(problem);
+  ConfigureCholmod(CholmodLayout::kAutomatic, &factor_);
+  factor_.AnalyzePatternWithOrdering(K_, ordering_);
+}
+
+SparseMatrix CertificateMatrix::BaseMatrix() const {
+  const int t0 = translation_size_, d = d_;
   std::vector<Triplet> triplets;
-  const SparseMatrix& L = problem.Lbar();
-  const SparseMatrix& V = problem.Vbar();
-  const SparseMatrix& D = problem.D();
+  const SparseMatrix& L = problem_.Lbar();
+  const SparseMatrix& V = problem_.Vbar();
+  const SparseMatrix& D = problem_.D();
   triplets.reserve(L.nonZeros() + V.nonZeros() + D.nonZeros() + n_ * d * d);
   for (int k = 0; k < L.outerSize(); ++k) {
     for (SparseMatrix::InnerIterator it(L, k); it; ++it) {
@@ -87,36 +115,22 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
     }
   }
   const int size = t0 + rotation_size_;
-  K_.resize(size, size);
-  K_.setFromTriplets(triplets.begin(), triplets.end());
-  K_.makeCompressed();
-  base_values_.assign(K_.valuePtr(), K_.valuePtr() + K_.nonZeros());
-  translation_diagonal_.reserve(t0);
-  for (int j = 0; j < t0; ++j) {
-    // Lower triangle, sorted rows: the diagonal leads its column.
-    const int k = K_.outerIndexPtr()[j];
-    CHECK_EQ(K_.innerIndexPtr()[k], j);
-    translation_diagonal_.push_back(k);
-  }
-  block_entry_.reserve(n_ * d * (d + 1) / 2);
-  for (int i = 0; i < n_; ++i) {
-    for (int b = 0; b < d; ++b) {
-      const int col = t0 + d * i + b;
-      const int* begin = K_.innerIndexPtr() + K_.outerIndexPtr()[col];
-      const int* end = K_.innerIndexPtr() + K_.outerIndexPtr()[col + 1];
-      for (int a = b; a < d; ++a) {
-        const int* pos = std::lower_bound(begin, end, t0 + d * i + a);
-        block_entry_.push_back(static_cast<int>(pos - K_.innerIndexPtr()));
-      }
-    }
-  }
-  data_rounding_.resize(size);
-  for (int k = 0; k < problem.num_translations(); ++k) {
-    const int j = problem.layout().reduced(k);
-    if (j >= 0) data_rounding_[j] = problem.translation_row_rounding()[k];
+  SparseMatrix K(size, size);
+  K.setFromTriplets(triplets.begin(), triplets.end());
+  K.makeCompressed();
+  return K;
+}
+
+void CertificateMatrix::SetData(const SparseMatrix& base) {
+  const int t0 = translation_size_;
+  base_values_.assign(base.valuePtr(), base.valuePtr() + base.nonZeros());
+  data_rounding_.resize(base.rows());
+  for (int k = 0; k < problem_.num_translations(); ++k) {
+    const int j = problem_.layout().reduced(k);
+    if (j >= 0) data_rounding_[j] = problem_.translation_row_rounding()[k];
   }
   for (int q = 0; q < rotation_size_; ++q) {
-    data_rounding_[t0 + q] = problem.rotation_row_rounding()[q];
+    data_rounding_[t0 + q] = problem_.rotation_row_rounding()[q];
   }
   // The translation rows of K's factor carry round-off of the size of
   // Lbar's own factorization (4-25x its bound on the benchmark datasets);
@@ -124,11 +138,20 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
   double data_head = 0;
   for (int j = 0; j < t0; ++j)
     data_head = std::max(data_head, data_rounding_[j]);
-  double_shift_ = 64 * problem.LbarBackwardError() + 2 * data_head;
+  double_shift_ = 64 * problem_.LbarBackwardError() + 2 * data_head;
   extended_shift_ = double_shift_ * kDoubleDoubleUnitRoundoff / kUnitRoundoff;
-  ordering_ = BlockOrdering(problem);
-  ConfigureCholmod(CholmodLayout::kAutomatic, &factor_);
-  factor_.AnalyzePatternWithOrdering(K_, ordering_);
+}
+
+void CertificateMatrix::Refresh() {
+  const SparseMatrix base = BaseMatrix();
+  const int size = static_cast<int>(K_.rows());
+  CHECK(base.nonZeros() == K_.nonZeros() &&
+        std::equal(base.outerIndexPtr(), base.outerIndexPtr() + size + 1,
+                   K_.outerIndexPtr()) &&
+        std::equal(base.innerIndexPtr(), base.innerIndexPtr() + K_.nonZeros(),
+                   K_.innerIndexPtr()))
+      << "certificate matrix: the problem's sparsity pattern changed";
+  SetData(base);
 }
 
 CertificateMatrix::~CertificateMatrix() = default;
@@ -286,7 +309,8 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
     DCHECK(pos != inner + outer[col + 1] && *pos == row);
     return static_cast<int>(pos - inner);
   };
-  // K_c from the measurements: the data terms in double-double (products
+  // K_c from the measurements (with the problem's weights, as doubles:
+  // measurement_weights.h): the data terms in double-double (products
   // of two doubles exact, of three within 5u^2, sums within 3.2u^2) and
   // per-row sums of |terms| with their counts for the assembly's bound.
   // Translation nodes map to K's rows through ProblemLayout::reduced (the
@@ -296,15 +320,17 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
   std::vector<int> count(size, 0);
   const ProblemLayout& layout = problem_.layout();
   ForEachDataTerm<DoubleDouble>(
-      problem_.graph(),
+      problem_.graph(), problem_.weights(),
       [&](DataBlock block, int row, int col, const DoubleDouble& value) {
         const double magnitude = value.AbsUpperBound();
+        // Exact zeros (zero weights) carry no rounding: not counted.
+        const int term = value.hi != 0 || value.lo != 0 ? 1 : 0;
         switch (block) {
           case DataBlock::kTranslation: {
             const int r = layout.reduced(row), s = layout.reduced(col);
             if (r < 0 || s < 0) return;  // The gauge node: fixed at 0.
             abs_sum[r] += magnitude;
-            ++count[r];
+            count[r] += term;
             if (r >= s) base[index(r, s)] += value;
             return;
           }
@@ -312,9 +338,9 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
             const int r = layout.reduced(row), s = t0 + col;
             if (r < 0) return;
             abs_sum[r] += magnitude;
-            ++count[r];
+            count[r] += term;
             abs_sum[s] += magnitude;
-            ++count[s];
+            count[s] += term;
             base[index(s, r)] -= value;
             return;
           }
@@ -322,7 +348,7 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
           case DataBlock::kRotationSigma: {
             const int r = t0 + row, s = t0 + col;
             abs_sum[r] += magnitude;
-            ++count[r];
+            count[r] += term;
             if (r >= s) base[index(r, s)] += value;
             return;
           }

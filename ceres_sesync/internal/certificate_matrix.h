@@ -35,9 +35,17 @@ const char* ProofPrecisionName(ProofPrecision precision);
 
 class CertificateMatrix {
  public:
-  // `problem` must outlive this object.
+  // `problem` must outlive this object. K's base values (without Lambda and
+  // c) and the data's rounding bounds are copied from it here.
   explicit CertificateMatrix(const SESyncProblem& problem);
   ~CertificateMatrix();
+
+  // After problem.UpdateWeights(): copies the new base values and rounding
+  // bounds. The pattern is the same, so the symbolic analyses (CHOLMOD's and
+  // the double-double one) are kept; the next factorization is numeric
+  // only. The double-double proofs assemble from ForEachDataTerm with the
+  // problem's weights, so they are of the weighted problem too.
+  void Refresh();
 
   // Factorizes K_c in double for solves (the preconditioner, the
   // eigensolver): no proof. Returns true iff the factorization completed.
@@ -109,6 +117,10 @@ class CertificateMatrix {
   bool supernodal() const { return factor_.IsSupernodal(); }
 
  private:
+  // K's pattern with the problem's current base values.
+  SparseMatrix BaseMatrix() const;
+  // base_values_, data_rounding_ and the initial shifts from `base`.
+  void SetData(const SparseMatrix& base);
   // K_ = K_c with Lambda, c and the translation block Lbar - mu I; returns
   // per-row bounds on the rounding of this assembly.
   void Assemble(const Eigen::MatrixXd& Lambda, double c, double mu,

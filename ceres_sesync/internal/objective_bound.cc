@@ -40,11 +40,14 @@ struct ResidualBound {
 }  // namespace
 
 double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
-                           const LandmarkPositions& landmarks) {
+                           const LandmarkPositions& landmarks,
+                           const MeasurementWeights& weights) {
   const int d = graph.dimension;
   const double g = Gamma(d + 2);
   double f = 0, error = 0;
-  for (const RelativePoseMeasurement& e : graph.measurements) {
+  for (size_t k = 0; k < graph.measurements.size(); ++k) {
+    const RelativePoseMeasurement& e = graph.measurements[k];
+    const Precisions w = WeightedPrecisions(e, weights, k);
     const Pose& a = poses[e.i];
     const Pose& b = poses[e.j];
     // Rotation residual R_j - R_i R~: entries (p, q).
@@ -62,8 +65,8 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
     // Translation residual t_j - t_i - R_i t~.
     ResidualBound translation{d, g};
     translation.Translation(b.t, a.t, a.R, e.t);
-    f += e.kappa * rotation.value + e.tau * translation.value;
-    error += e.kappa * rotation.error + e.tau * translation.error;
+    f += w.kappa * rotation.value + w.tau * translation.value;
+    error += w.kappa * rotation.error + w.tau * translation.error;
   }
   // Landmark residuals p_l - t_i - R_i z.
   for (const LandmarkMeasurement& o : graph.landmark_measurements) {
@@ -103,10 +106,12 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
   return f + (2 * Gamma(terms) * (f + error) + error) * (1 + 1e-6);
 }
 
-double TotalPrecision(const PoseGraph& graph) {
+double TotalPrecision(const PoseGraph& graph,
+                      const MeasurementWeights& weights) {
   double total = 0;
-  for (const RelativePoseMeasurement& e : graph.measurements) {
-    total += e.kappa + e.tau;
+  for (size_t k = 0; k < graph.measurements.size(); ++k) {
+    const Precisions w = WeightedPrecisions(graph.measurements[k], weights, k);
+    total += w.kappa + w.tau;
   }
   for (const LandmarkMeasurement& o : graph.landmark_measurements) {
     total += o.nu;

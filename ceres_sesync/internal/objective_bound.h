@@ -6,6 +6,7 @@
 #ifndef CERES_SESYNC_INTERNAL_OBJECTIVE_BOUND_H_
 #define CERES_SESYNC_INTERNAL_OBJECTIVE_BOUND_H_
 
+#include "ceres_sesync/internal/measurement_weights.h"
 #include "ceres_sesync/pose_graph.h"
 
 namespace ceres_sesync::internal {
@@ -20,18 +21,25 @@ namespace ceres_sesync::internal {
 // of translations far from the origin cancel more digits). Landmark
 // measurements are bounded like the translation residuals of edges, priors
 // like an edge from the identity pose. `landmarks` must hold one position
-// per landmark.
+// per landmark. With `weights`, the same for the weighted problem
+// (measurement_weights.h: its precisions are doubles, so the analysis is
+// unchanged; weights apply to the pose-pose measurements only).
 double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
-                           const LandmarkPositions& landmarks = {});
+                           const LandmarkPositions& landmarks = {},
+                           const MeasurementWeights& weights = {});
 inline double ObjectiveUpperBound(const PoseGraph& graph,
-                                  const Solution& solution) {
-  return ObjectiveUpperBound(graph, solution.poses, solution.landmarks);
+                                  const Solution& solution,
+                                  const MeasurementWeights& weights = {}) {
+  return ObjectiveUpperBound(graph, solution.poses, solution.landmarks,
+                             weights);
 }
 
 // The sum of every precision of the graph (kappa and tau of the edges, nu of
 // the landmark measurements, kappa and tau of the priors): the scale below
-// which an objective value is zero up to round-off.
-double TotalPrecision(const PoseGraph& graph);
+// which an objective value is zero up to round-off. With `weights`, of the
+// weighted problem.
+double TotalPrecision(const PoseGraph& graph,
+                      const MeasurementWeights& weights = {});
 
 }  // namespace ceres_sesync::internal
 

@@ -18,9 +18,16 @@ SESyncPreconditioner::SESyncPreconditioner(
       num_threads_(problem.num_threads()),
       type_(type),
       settings_(settings),
+      max_condition_(max_condition),
       workspace_(workspace) {
-  if (type == PreconditionerType::kNone) return;
-  const SparseMatrix& D = problem.D();
+  Refresh();
+}
+
+SESyncPreconditioner::~SESyncPreconditioner() = default;
+
+void SESyncPreconditioner::Refresh() {
+  if (type_ == PreconditionerType::kNone) return;
+  const SparseMatrix& D = problem_.D();
   // Gershgorin bound on lambda_max(D).
   Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(D.rows());
   for (int k = 0; k < D.outerSize(); ++k) {
@@ -28,11 +35,16 @@ SESyncPreconditioner::SESyncPreconditioner(
       row_sums(it.row()) += std::abs(it.value());
     }
   }
-  eps_ = row_sums.maxCoeff() / max_condition;
+  eps_ = row_sums.maxCoeff() / max_condition_;
   const double eps = eps_;
-  const int d = d_, n = problem.num_rotations();
-  if (type == PreconditionerType::kBlockJacobi ||
-      type == PreconditionerType::kAdaptive) {
+  const int d = d_, n = problem_.num_rotations();
+  if (type_ == PreconditionerType::kRegularizedQ ||
+      (type_ == PreconditionerType::kAdaptive && exact_)) {
+    FactorizeRegularizedQ();
+    return;
+  }
+  if (type_ == PreconditionerType::kBlockJacobi ||
+      type_ == PreconditionerType::kAdaptive) {
     block_inverses_.resize(d, d * n);
     const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(d, d);
     for (int i = 0; i < n; ++i) {
@@ -42,26 +54,23 @@ SESyncPreconditioner::SESyncPreconditioner(
     }
     return;
   }
-  if (type == PreconditionerType::kRegularizedQ) {
-    FactorizeRegularizedQ();
-    return;
-  }
   SparseMatrix regularized = D;
   for (int k = 0; k < regularized.rows(); ++k) {
     regularized.coeffRef(k, k) += eps;
   }
-  CholmodFactor factor;
-  ConfigureCholmod(CholmodLayout::kSimplicial, &factor);
-  factor.compute(regularized);
-  CHECK(factor.info() == Eigen::Success)
+  if (!d_factor_) {
+    d_factor_ = std::make_unique<CholmodFactor>();
+    ConfigureCholmod(CholmodLayout::kSimplicial, d_factor_.get());
+    d_factor_->analyzePattern(regularized);
+  }
+  d_factor_->factorize(regularized);
+  CHECK(d_factor_->info() == Eigen::Success)
       << "regularized Cholesky preconditioner failed";
-  factor_ = factor.ExtractFactor();
+  factor_ = d_factor_->ExtractFactor();
   if (settings_.precision == FactorPrecision::kSingle) {
     factor_.ConvertToSinglePrecision();
   }
 }
-
-SESyncPreconditioner::~SESyncPreconditioner() = default;
 
 void SESyncPreconditioner::FactorizeRegularizedQ() {
   CertificateMatrix* workspace = workspace_;

@@ -59,6 +59,11 @@ class SESyncPreconditioner {
                        CertificateMatrix* workspace = nullptr,
                        const PreconditionerSettings& settings = {});
   ~SESyncPreconditioner();
+  // After problem.UpdateWeights() (and the workspace's Refresh()):
+  // recomputes eps and refactorizes numerically, reusing the symbolic
+  // analysis (of the workspace for the exact preconditioner, of its own
+  // factor for kSparseCholesky). kAdaptive keeps its current mode.
+  void Refresh();
   // X = V (D + eps I)^{-1} (or the block-Jacobi version); V is r x dn.
   void Apply(const Eigen::MatrixXd& V, Eigen::MatrixXd* X) const;
   PreconditionerType type() const { return type_; }
@@ -85,9 +90,13 @@ class SESyncPreconditioner {
   int num_threads_;
   PreconditionerType type_;
   PreconditionerSettings settings_;
+  double max_condition_;
   double eps_ = 0;
   CertificateMatrix* workspace_ = nullptr;
   std::unique_ptr<CertificateMatrix> own_workspace_;
+  // kSparseCholesky's factorization of D + eps I (its analysis is kept for
+  // Refresh()).
+  std::unique_ptr<CholmodFactor> d_factor_;
   bool exact_ = false;
   int switches_ = 0;
   Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "ceres_sesync/internal/parallel.h"
@@ -215,93 +216,19 @@ ProblemLayout::ProblemLayout(const PoseGraph& graph)
   }
 }
 
-SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
+SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
+                             MeasurementWeights weights)
     : graph_(&graph),
       layout_(graph),
+      weights_(std::move(weights)),
       d_(graph.dimension),
       n_(layout_.num_rotations()),
       num_threads_(std::max(1, num_threads)) {
-  const int d = d_, n = n_, N = layout_.num_translations();
-  std::vector<Triplet> lrho, sigma, v, lw;
-  const size_t m = graph.measurements.size() + graph.priors.size();
-  const size_t m_t = m + graph.landmark_measurements.size();
-  lrho.reserve(m * (2 * d + 2 * d * d));
-  sigma.reserve(m_t * d * d);
-  v.reserve(2 * m_t * d);
-  lw.reserve(4 * m_t);
-  // Per row of M: the sum of |terms| and their number, for the rounding
-  // bounds. Rows of D carry the terms of L(G^rho) and Sigma~ plus one more
-  // rounding (their sum).
-  std::vector<double> t_abs(N, 0.0), r_abs(d * n, 0.0);
-  std::vector<int> t_count(N, 0), r_count(d * n, 0);
-  ForEachDataTerm<double>(
-      graph, [&](DataBlock block, int row, int col, double value) {
-        switch (block) {
-          case DataBlock::kTranslation:
-            lw.emplace_back(row, col, value);
-            t_abs[row] += std::abs(value);
-            ++t_count[row];
-            return;
-          case DataBlock::kCoupling:  // M has -V at (row, col) and (col, row).
-            v.emplace_back(row, col, value);
-            t_abs[row] += std::abs(value);
-            ++t_count[row];
-            r_abs[col] += std::abs(value);
-            ++r_count[col];
-            return;
-          case DataBlock::kRotation:
-            lrho.emplace_back(row, col, value);
-            break;
-          case DataBlock::kRotationSigma:
-            sigma.emplace_back(row, col, value);
-            break;
-        }
-        r_abs[row] += std::abs(value);
-        ++r_count[row];
-      });
-  // Each stored entry is a sum of at most k rounded terms (a product of up
-  // to three doubles: two roundings each) plus one rounding of the sum
-  // L(G^rho) + Sigma~: within gamma_{k+3} of its exact value, k bounded by
-  // the row's terms. The factor (1 + 1e-6) covers this computation's own
-  // rounding.
-  auto bound = [](int count, double abs_sum) {
-    const double g =
-        (count + 3) * kUnitRoundoff / (1 - (count + 3) * kUnitRoundoff);
-    return g * abs_sum * (1 + 1e-6);
-  };
-  translation_row_rounding_.resize(N);
-  for (int i = 0; i < N; ++i)
-    translation_row_rounding_[i] = bound(t_count[i], t_abs[i]);
-  rotation_row_rounding_.resize(d * n);
-  for (int i = 0; i < d * n; ++i)
-    rotation_row_rounding_[i] = bound(r_count[i], r_abs[i]);
-  Lrho_.resize(d * n, d * n);
-  Lrho_.setFromTriplets(lrho.begin(), lrho.end());
-  SparseMatrix sigma_matrix(d * n, d * n);
-  sigma_matrix.setFromTriplets(sigma.begin(), sigma.end());
-  D_ = Lrho_ + sigma_matrix;
-
-  // Drop the gauge node (t_0 = 0, or t_w = 0 with position priors) from the
-  // translational blocks.
+  CHECK(weights_.empty() || weights_.size() == graph.measurements.size());
+  std::vector<Triplet> vertex_pattern;
+  Assemble(&vertex_pattern);
   const ProblemLayout& layout = layout_;
-  std::vector<Triplet> vbar, lbar;
-  for (const Triplet& t : v) {
-    const int row = layout.reduced(t.row());
-    if (row >= 0) vbar.emplace_back(row, t.col(), t.value());
-  }
-  for (const Triplet& t : lw) {
-    const int row = layout.reduced(t.row()), col = layout.reduced(t.col());
-    if (row >= 0 && col >= 0) lbar.emplace_back(row, col, t.value());
-  }
-  Vbar_.resize(N - 1, d * n);
-  Vbar_.setFromTriplets(vbar.begin(), vbar.end());
-  VbarT_ = Vbar_.transpose();
-  minus_Vbar_ = -Vbar_;
-  D_.makeCompressed();
-  VbarT_.makeCompressed();
-  minus_Vbar_.makeCompressed();
-  Lbar_.resize(N - 1, N - 1);
-  Lbar_.setFromTriplets(lbar.begin(), lbar.end());
+  const int N = layout.num_translations();
   const int num_vertices = layout.num_vertices();
   if (num_vertices == 1) {
     vertex_ordering_ = {0};
@@ -319,31 +246,13 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   // pose (about where its ~7 us per pose pays off), and kept if it predicts
   // fewer flops.
   {
-    std::vector<Triplet> vertex_pattern = lw;
-    if (graph.has_landmarks_or_priors()) {
-      // Rotation-only priors (L(G^rho)) and the couplings of landmarks and
-      // position priors to their rotations (V) are not all in L(W^tau).
-      for (const Triplet& t : v) {
-        const int a = t.row(), b = layout.vertex_of_rotation(t.col() / d);
-        vertex_pattern.emplace_back(a, b, 1.0);
-        vertex_pattern.emplace_back(b, a, 1.0);
-      }
-      for (const Triplet& t : lrho) {
-        vertex_pattern.emplace_back(layout.vertex_of_rotation(t.row() / d),
-                                    layout.vertex_of_rotation(t.col() / d),
-                                    1.0);
-      }
-      for (int k = 0; k < num_vertices; ++k) {
-        vertex_pattern.emplace_back(k, k, 1.0);
-      }
-    }
     SparseMatrix pattern(num_vertices, num_vertices);
     pattern.setFromTriplets(vertex_pattern.begin(), vertex_pattern.end());
     CholmodFactor analysis;
     ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
     analysis.analyzePattern(pattern);
     vertex_ordering_ = analysis.Ordering();
-    const double block_flops = std::pow(d + 1.0, 3) / 2;
+    const double block_flops = std::pow(d_ + 1.0, 3) / 2;
     const double flops = analysis.cholmod().fl;
     if (flops * block_flops > 2e4 * num_vertices) {
       CholmodFactor nested;
@@ -374,11 +283,141 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads)
   lbar_factor_ = std::make_unique<CholmodFactor>();
   ConfigureCholmod(CholmodLayout::kSimplicial, lbar_factor_.get());
   lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
+  FactorizeLbar();
+}
+
+void SESyncProblem::Assemble(std::vector<Triplet>* vertex_pattern) {
+  const PoseGraph& graph = *graph_;
+  const int d = d_, n = n_, N = layout_.num_translations();
+  std::vector<Triplet> lrho, sigma, v, lw;
+  const size_t m = graph.measurements.size() + graph.priors.size();
+  const size_t m_t = m + graph.landmark_measurements.size();
+  lrho.reserve(m * (2 * d + 2 * d * d));
+  sigma.reserve(m_t * d * d);
+  v.reserve(2 * m_t * d);
+  lw.reserve(4 * m_t);
+  // Per row of M: the sum of |terms| and their number, for the rounding
+  // bounds. Rows of D carry the terms of L(G^rho) and Sigma~ plus one more
+  // rounding (their sum). Exact zeros (the terms of zero weights) carry no
+  // rounding and are not counted, so the bounds of a problem with weights
+  // in {0, 1} are those of its weight-1 measurements alone.
+  std::vector<double> t_abs(N, 0.0), r_abs(d * n, 0.0);
+  std::vector<int> t_count(N, 0), r_count(d * n, 0);
+  ForEachDataTerm<double>(
+      graph, weights_, [&](DataBlock block, int row, int col, double value) {
+        const int term = value != 0 ? 1 : 0;
+        switch (block) {
+          case DataBlock::kTranslation:
+            lw.emplace_back(row, col, value);
+            t_abs[row] += std::abs(value);
+            t_count[row] += term;
+            return;
+          case DataBlock::kCoupling:  // M has -V at (row, col) and (col, row).
+            v.emplace_back(row, col, value);
+            t_abs[row] += std::abs(value);
+            t_count[row] += term;
+            r_abs[col] += std::abs(value);
+            r_count[col] += term;
+            return;
+          case DataBlock::kRotation:
+            lrho.emplace_back(row, col, value);
+            break;
+          case DataBlock::kRotationSigma:
+            sigma.emplace_back(row, col, value);
+            break;
+        }
+        r_abs[row] += std::abs(value);
+        r_count[row] += term;
+      });
+  // Each stored entry is a sum of at most k rounded terms (a product of up
+  // to three doubles: two roundings each) plus one rounding of the sum
+  // L(G^rho) + Sigma~: within gamma_{k+3} of its exact value, k bounded by
+  // the row's terms. The factor (1 + 1e-6) covers this computation's own
+  // rounding.
+  auto bound = [](int count, double abs_sum) {
+    const double g =
+        (count + 3) * kUnitRoundoff / (1 - (count + 3) * kUnitRoundoff);
+    return g * abs_sum * (1 + 1e-6);
+  };
+  translation_row_rounding_.resize(N);
+  for (int i = 0; i < N; ++i)
+    translation_row_rounding_[i] = bound(t_count[i], t_abs[i]);
+  rotation_row_rounding_.resize(d * n);
+  for (int i = 0; i < d * n; ++i)
+    rotation_row_rounding_[i] = bound(r_count[i], r_abs[i]);
+  // setFromTriplets and the sparse sums below keep explicit zeros, so the
+  // patterns depend on the graph only.
+  Lrho_.resize(d * n, d * n);
+  Lrho_.setFromTriplets(lrho.begin(), lrho.end());
+  SparseMatrix sigma_matrix(d * n, d * n);
+  sigma_matrix.setFromTriplets(sigma.begin(), sigma.end());
+  D_ = Lrho_ + sigma_matrix;
+
+  // Drop the gauge node (t_0 = 0, or t_w = 0 with position priors) from the
+  // translational blocks.
+  const ProblemLayout& layout = layout_;
+  std::vector<Triplet> vbar, lbar;
+  for (const Triplet& t : v) {
+    const int row = layout.reduced(t.row());
+    if (row >= 0) vbar.emplace_back(row, t.col(), t.value());
+  }
+  for (const Triplet& t : lw) {
+    const int row = layout.reduced(t.row()), col = layout.reduced(t.col());
+    if (row >= 0 && col >= 0) lbar.emplace_back(row, col, t.value());
+  }
+  Vbar_.resize(N - 1, d * n);
+  Vbar_.setFromTriplets(vbar.begin(), vbar.end());
+  VbarT_ = Vbar_.transpose();
+  minus_Vbar_ = -Vbar_;
+  D_.makeCompressed();
+  VbarT_.makeCompressed();
+  minus_Vbar_.makeCompressed();
+  Lbar_.resize(N - 1, N - 1);
+  Lbar_.setFromTriplets(lbar.begin(), lbar.end());
+  if (vertex_pattern) {
+    const int num_vertices = layout.num_vertices();
+    *vertex_pattern = lw;
+    if (graph.has_landmarks_or_priors()) {
+      // Rotation-only priors (L(G^rho)) and the couplings of landmarks and
+      // position priors to their rotations (V) are not all in L(W^tau).
+      for (const Triplet& t : v) {
+        const int a = t.row(), b = layout.vertex_of_rotation(t.col() / d);
+        vertex_pattern->emplace_back(a, b, 1.0);
+        vertex_pattern->emplace_back(b, a, 1.0);
+      }
+      for (const Triplet& t : lrho) {
+        vertex_pattern->emplace_back(layout.vertex_of_rotation(t.row() / d),
+                                     layout.vertex_of_rotation(t.col() / d),
+                                     1.0);
+      }
+      for (int k = 0; k < num_vertices; ++k) {
+        vertex_pattern->emplace_back(k, k, 1.0);
+      }
+    }
+  }
+}
+
+void SESyncProblem::FactorizeLbar() {
   lbar_factor_->factorize(Lbar_);
   ok_ = lbar_factor_->info() == Eigen::Success;
   if (ok_) lbar_solver_ = lbar_factor_->ExtractFactor();
   LOG_IF(ERROR, !ok_) << "Cholesky factorization of the reduced translational "
                          "Laplacian failed";
+}
+
+bool SESyncProblem::UpdateWeights(MeasurementWeights weights) {
+  CHECK(weights.empty() || weights.size() == graph_->measurements.size());
+  weights_ = std::move(weights);
+  const Eigen::Index nnz_D = D_.nonZeros(), nnz_V = Vbar_.nonZeros(),
+                     nnz_L = Lbar_.nonZeros();
+  Assemble(nullptr);
+  // The patterns are functions of the graph alone (see Assemble()).
+  CHECK(D_.nonZeros() == nnz_D && Vbar_.nonZeros() == nnz_V &&
+        Lbar_.nonZeros() == nnz_L)
+      << "re-weighting changed a sparsity pattern";
+  if (Lbar_.rows() == 0) return ok_ = true;
+  FactorizeLbar();
+  return ok_;
 }
 
 void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,

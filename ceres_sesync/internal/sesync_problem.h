@@ -28,11 +28,13 @@
 #define CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "Eigen/CholmodSupport"
 #include "Eigen/Core"
 #include "Eigen/SparseCore"
+#include "ceres_sesync/internal/measurement_weights.h"
 #include "ceres_sesync/internal/sparse_cholesky_factor.h"
 #include "ceres_sesync/pose_graph.h"
 
@@ -147,7 +149,9 @@ struct ProblemLayout {
 // The data matrix M of the objective as a sum of terms, one
 // visit(block, row, column, value) per term, with values computed in
 // `Scalar` from the measurements (double, or DoubleDouble for the
-// high-precision certificate). Blocks and their indices (ProblemLayout):
+// high-precision certificate) and the precisions of the weighted problem
+// (measurement_weights.h; empty weights: the graph's own). Blocks and their
+// indices (ProblemLayout):
 //   kTranslation:   L(W^tau), translation nodes (row, column);
 //   kCoupling:      V, translation node row, rotation column d*k + a;
 //   kRotation:      L(G^rho), rotation indices;
@@ -159,7 +163,9 @@ struct ProblemLayout {
 // landmark measurements (translation terms from pose i to node n + l with
 // t~ = z, tau = nu), then the priors (edges from w: rotation terms between
 // R_w and R_i with R~ if kappa > 0, translation terms from t_w to t_i with
-// t~ = g if tau > 0).
+// t~ = g if tau > 0). Weights apply to the relative pose measurements. The
+// terms visited, and so the sparsity pattern, do not depend on the weights:
+// a zero weight visits exact zeros.
 enum class DataBlock { kTranslation, kCoupling, kRotation, kRotationSigma };
 
 namespace data_terms {
@@ -204,11 +210,14 @@ void VisitRotationTerm(int d, int src, int dst, const Matrix& R,
 }  // namespace data_terms
 
 template <typename Scalar, typename Visit>
-void ForEachDataTerm(const PoseGraph& graph, Visit&& visit) {
+void ForEachDataTerm(const PoseGraph& graph, const MeasurementWeights& weights,
+                     Visit&& visit) {
   const int d = graph.dimension;
-  for (const RelativePoseMeasurement& e : graph.measurements) {
+  for (size_t k = 0; k < graph.measurements.size(); ++k) {
+    const RelativePoseMeasurement& e = graph.measurements[k];
     const int i = e.i, j = e.j;
-    const Scalar kappa(e.kappa), tau(e.tau);
+    const Precisions p = WeightedPrecisions(e, weights, k);
+    const Scalar kappa(p.kappa), tau(p.tau);
     for (int a = 0; a < d; ++a) {
       visit(DataBlock::kRotation, d * i + a, d * i + a, kappa);
       visit(DataBlock::kRotation, d * j + a, d * j + a, kappa);
@@ -249,15 +258,35 @@ void ForEachDataTerm(const PoseGraph& graph, Visit&& visit) {
   }
 }
 
+template <typename Scalar, typename Visit>
+void ForEachDataTerm(const PoseGraph& graph, Visit&& visit) {
+  ForEachDataTerm<Scalar>(graph, MeasurementWeights(),
+                          std::forward<Visit>(visit));
+}
+
 class SESyncProblem {
  public:
   // `graph` must pass ValidatePoseGraph and outlive this object. Check ok()
   // afterwards: it fails only if the translational Laplacian could not be
   // factorized. Products with Q use up to `num_threads` threads (results do
-  // not depend on it).
-  explicit SESyncProblem(const PoseGraph& graph, int num_threads = 1);
+  // not depend on it). `weights` (measurement_weights.h; empty: all 1)
+  // define the weighted problem; they must pass CheckMeasurementWeights.
+  explicit SESyncProblem(const PoseGraph& graph, int num_threads = 1,
+                         MeasurementWeights weights = {});
 
   const PoseGraph& graph() const { return *graph_; }
+  // The weights of the problem (empty: all 1).
+  const MeasurementWeights& weights() const { return weights_; }
+
+  // Re-weights the problem in place: recomputes the VALUES of every matrix
+  // and the rounding bounds from ForEachDataTerm with the new weights. The
+  // sparsity patterns do not change (zero weights keep explicit zeros), so
+  // the vertex ordering and Lbar's symbolic analysis are kept and Lbar is
+  // only refactorized numerically. Users of the matrices holding values or
+  // factors of their own (CertificateMatrix, SESyncPreconditioner) must be
+  // refreshed too. `weights` must pass CheckMeasurementWeights (connected);
+  // returns ok().
+  bool UpdateWeights(MeasurementWeights weights);
 
   bool ok() const { return ok_; }
   int dimension() const { return d_; }
@@ -310,8 +339,17 @@ class SESyncProblem {
   }
 
  private:
+  // The values of every matrix and the rounding bounds from the current
+  // weights (the patterns are the same for all weights). `vertex_pattern`
+  // (if not null) gets the pattern of M collapsed to vertices (the terms of
+  // L(W^tau), plus those of landmarks and priors), for the ordering.
+  void Assemble(std::vector<Eigen::Triplet<double>>* vertex_pattern);
+  // Numeric factorization of Lbar (symbolic analysis done); sets ok_.
+  void FactorizeLbar();
+
   const PoseGraph* graph_ = nullptr;
   ProblemLayout layout_;
+  MeasurementWeights weights_;
   int d_ = 0, n_ = 0, num_threads_ = 1;
   std::vector<double> translation_row_rounding_, rotation_row_rounding_;
   bool ok_ = false;

@@ -1,9 +1,11 @@
 #include "ceres_sesync/internal/staircase.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <utility>
 
 #include "ceres_sesync/internal/ceres_local_solver.h"
 #include "ceres_sesync/internal/chordal.h"
@@ -85,7 +87,8 @@ Solution ToSolutionInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
 }
 
 Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
-                     SolverSummary* summary, Clock::time_point start)
+                     SolverSummary* summary, Clock::time_point start,
+                     MeasurementWeights weights)
     : graph_(graph), options_(options), summary_(summary), start_(start) {
   *summary_ = SolverSummary();
   SolverSummary& s = *summary_;
@@ -97,9 +100,20 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   s.num_landmark_measurements =
       static_cast<int>(graph.landmark_measurements.size());
   s.num_priors = static_cast<int>(graph.priors.size());
-  if (!ValidatePoseGraph(graph, &s.message)) {
+  if (!ValidatePoseGraph(graph, &s.message) ||
+      !CheckMeasurementWeights(graph, weights, &s.message)) {
     s.status = SolverSummary::Status::kInvalidInput;
     return;
+  }
+  if (!weights.empty() && (graph.num_landmarks > 0 || !graph.priors.empty())) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message =
+        "measurement weights are not supported with landmarks or priors";
+    return;
+  }
+  if (!weights.empty()) {
+    s.num_measurements = static_cast<int>(std::count_if(
+        weights.begin(), weights.end(), [](double w) { return w > 0; }));
   }
   const ProblemLayout layout(graph);
   d_ = graph.dimension;
@@ -123,7 +137,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   Progress("data");
   const auto t = Clock::now();
   problem_ = std::make_unique<SESyncProblem>(
-      graph, ResolveNumThreads(options.num_threads));
+      graph, ResolveNumThreads(options.num_threads), std::move(weights));
   if (!problem_->ok()) {
     s.status = SolverSummary::Status::kInvalidInput;
     s.message = "the translational Laplacian is not positive definite";
@@ -134,12 +148,57 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
       *problem_, ToInternal(options.preconditioner),
       options.regularized_cholesky_max_condition, certificate_.get());
   cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
+  SetScales();
+  s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
+  ok_ = true;
+}
+
+void Staircase::SetScales() {
   scale_ = MaxDiagonal(problem_->D());
   // Objective values below this are zero up to round-off (F is a sum of
   // squares weighted by the precisions).
-  zero_objective_ = 1e-12 * TotalPrecision(graph);
+  zero_objective_ = 1e-12 * TotalPrecision(graph_, problem_->weights());
+}
+
+bool Staircase::Reweight(MeasurementWeights weights, Clock::time_point start) {
+  CHECK(problem_ != nullptr) << "Reweight() needs a valid, non-trivial problem";
+  start_ = start;
+  const int m = static_cast<int>(graph_.measurements.size());
+  SolverSummary& s = *summary_;
+  s = SolverSummary();
+  s.lambda_min_estimate = std::numeric_limits<double>::quiet_NaN();
+  s.dimension = d_;
+  s.num_poses = graph_.num_poses;
+  s.num_measurements =
+      weights.empty()
+          ? m
+          : static_cast<int>(std::count_if(weights.begin(), weights.end(),
+                                           [](double w) { return w > 0; }));
+  ok_ = false;
+  if (graph_.num_landmarks > 0 || !graph_.priors.empty()) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message =
+        "measurement weights are not supported with landmarks or priors";
+    return false;
+  }
+  if (!CheckMeasurementWeights(graph_, weights, &s.message)) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    return false;
+  }
+  const auto t = Clock::now();
+  if (!problem_->UpdateWeights(std::move(weights))) {
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message = "the translational Laplacian is not positive definite";
+    return false;
+  }
+  certificate_->Refresh();
+  preconditioner_->Refresh();
+  SetScales();
+  verification_ = VerificationResult();
+  sdp_value_ = lower_bound_ = 0;
+  extended_deferred_ = false;
   s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
-  ok_ = true;
+  return ok_ = true;
 }
 
 Staircase::~Staircase() = default;
@@ -505,7 +564,10 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
 
 void Staircase::Report(const Eigen::MatrixXd& Y, const Solution& solution) {
   SolverSummary& s = *summary_;
-  s.objective = EvaluateObjective(graph_, solution);
+  s.objective =
+      problem_->weights().empty()
+          ? EvaluateObjective(graph_, solution)
+          : WeightedObjective(graph_, problem_->weights(), solution.poses);
   if (extended_deferred_ && verification_.certified) {
     TightenProof(Y, s.objective);
   }
@@ -523,7 +585,8 @@ void Staircase::Report(const Eigen::MatrixXd& Y, const Solution& solution) {
   s.lower_bound = std::min(s.lower_bound, s.objective);
   // F(x) rounded up: the bound must not rest on round-off in F.
   s.suboptimality_bound =
-      std::max(0.0, ObjectiveUpperBound(graph_, solution) - s.lower_bound);
+      std::max(0.0, ObjectiveUpperBound(graph_, solution, problem_->weights()) -
+                        s.lower_bound);
   // A numerically zero F is optimal by F >= 0 (no ratio to a zero bound).
   s.relative_suboptimality_bound =
       s.objective <= zero_objective_ ? 0

@@ -23,6 +23,16 @@
 //
 // Every stage records what it did in the SolverSummary given at
 // construction (times, levels, counts).
+//
+// Weighted problems (measurement_weights.h; the GNC loop of robust_solver.cc)
+// reuse one Staircase: Reweight() changes the data matrices' values in place
+// (keeping every symbolic analysis) and starts a new solve, which Run()
+// warm-starts from the previous Y:
+//
+//   staircase.Reweight(weights);   // a new solve of the weighted problem
+//   staircase.Run(&Y);             // from the previous factor
+//   Solution x = staircase.Round(Y);
+//   staircase.Report(Y, x);        // F, bounds: of the weighted problem
 
 #ifndef CERES_SESYNC_INTERNAL_STAIRCASE_H_
 #define CERES_SESYNC_INTERNAL_STAIRCASE_H_
@@ -44,12 +54,15 @@ class Staircase {
  public:
   using Clock = std::chrono::steady_clock;
 
-  // Stage "problem": validates `graph` and `options` and builds the data
-  // matrices, the certificate matrix's symbolic analysis and the
-  // preconditioner. `graph`, `options` and `summary` must outlive this
-  // object; `summary` is reset. Time limits count from `start`.
+  // Stage "problem": validates `graph`, `options` and `weights`
+  // (measurement_weights.h; empty: all 1) and builds the data matrices of
+  // the (weighted) problem, the certificate matrix's symbolic analysis and
+  // the preconditioner. `graph`, `options` and `summary` must outlive this
+  // object (options are read at every stage); `summary` is reset. Time
+  // limits count from `start`.
   Staircase(const PoseGraph& graph, const SolverOptions& options,
-            SolverSummary* summary, Clock::time_point start = Clock::now());
+            SolverSummary* summary, Clock::time_point start = Clock::now(),
+            MeasurementWeights weights = {});
   ~Staircase();
 
   // False if validation or the data matrices failed (summary has the status
@@ -59,6 +72,20 @@ class Staircase {
   // summary is complete and Trivial() returns the solution.
   bool trivial() const { return trivial_; }
   Solution Trivial() const;
+
+  // Starts a new solve of the problem with these measurement weights
+  // (empty: all 1; they apply to the pose-pose measurements): the data
+  // matrices, the certificate matrix and the preconditioner get the new
+  // values (same patterns: the symbolic analyses are kept), the summary is
+  // reset as by the constructor (num_measurements: those of positive weight;
+  // data_time_s: this update) and time limits count from `start`. Returns
+  // false, with the summary's status kInvalidInput and a message, if the
+  // weights fail CheckMeasurementWeights (e.g. the positively weighted
+  // measurements leave the graph disconnected); ok() is then false until a
+  // successful Reweight(). Not for trivial problems, nor for graphs with
+  // landmarks or priors.
+  bool Reweight(MeasurementWeights weights,
+                Clock::time_point start = Clock::now());
 
   // Stage "initialize": Y (r0 x dn, n = problem().num_rotations()) from
   // `initial` (its rotations projected to SO(d); with priors they are in the
@@ -102,6 +129,8 @@ class Staircase {
   // Calls options.progress (if set) with the current elapsed time.
   void Progress(const char* stage, int rank = 0, int iteration = 0,
                 double objective = 0, double gradient_norm = 0) const;
+  // scale_ and zero_objective_ from the problem's current data.
+  void SetScales();
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
   // start + max_time_s, or time_point::max() for no limit.

@@ -1,0 +1,687 @@
+#include "ceres_sesync/robust_solver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "Eigen/Eigenvalues"
+#include "Eigen/Geometry"
+#include "ceres_sesync/internal/chi_square.h"
+#include "ceres_sesync/internal/measurement_weights.h"
+#include "ceres_sesync/internal/staircase.h"
+#include "ceres_sesync/stiefel_manifold.h"
+
+namespace ceres_sesync {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using internal::MeasurementWeights;
+constexpr double kPi = 3.14159265358979323846;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// The TLS surrogate rho_mu(r^2) and its Black-Rangarajan weight (Yang et
+// al. 2020, eqs. for the TLS case), both continuous in r^2.
+double TlsSurrogate(double r2, double mu, double c2) {
+  if (r2 <= mu / (mu + 1) * c2) return r2;
+  if (r2 >= (mu + 1) / mu * c2) return c2;
+  return 2 * std::sqrt(c2 * r2 * mu * (mu + 1)) - mu * (c2 + r2);
+}
+
+double TlsWeight(double r2, double mu, double c2) {
+  if (r2 <= mu / (mu + 1) * c2) return 1;
+  if (r2 >= (mu + 1) / mu * c2) return 0;
+  return std::clamp(std::sqrt(c2 * mu * (mu + 1) / r2) - mu, 0.0, 1.0);
+}
+
+// f_k at `poses` for every measurement (unweighted: the TLS residuals).
+std::vector<double> Costs(const PoseGraph& graph, const Poses& poses) {
+  std::vector<double> f(graph.measurements.size());
+  for (size_t k = 0; k < f.size(); ++k) {
+    const RelativePoseMeasurement& e = graph.measurements[k];
+    const Pose& a = poses[e.i];
+    const Pose& b = poses[e.j];
+    f[k] = e.kappa * (b.R - a.R * e.R).squaredNorm() +
+           e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
+  }
+  return f;
+}
+
+double RotationAngle(const Eigen::MatrixXd& M) {
+  if (M.rows() == 2) return std::abs(std::atan2(M(1, 0), M(0, 0)));
+  const Eigen::Matrix3d R = M;
+  return Eigen::AngleAxisd(Eigen::Quaterniond(R).normalized()).angle();
+}
+
+// Y without its negligible directions: with Y = U S V^T, the top k rows of
+// U^T Y, k the number of singular values above `tolerance` times the
+// largest (at least min_rank), each block projected back to St(d, k). A
+// warm start that keeps what the previous solve found but not the rank its
+// staircase needed for a problem that is no longer there.
+Eigen::MatrixXd ReduceRank(const Eigen::MatrixXd& Y, int d, int min_rank,
+                           double tolerance) {
+  const int r = static_cast<int>(Y.rows());
+  if (r <= min_rank) return Y;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(Y * Y.transpose());
+  const Eigen::VectorXd& lambda = gram.eigenvalues();  // Ascending.
+  int k = 0;
+  while (k < r && lambda[r - 1 - k] > tolerance * tolerance * lambda[r - 1])
+    ++k;
+  k = std::max(k + 1, min_rank);
+  if (k >= r) return Y;
+  const Eigen::MatrixXd X = gram.eigenvectors().rightCols(k).transpose() * Y;
+  Eigen::MatrixXd out;
+  ProjectToStiefelProduct(X, d, &out);
+  return out;
+}
+
+// Singular values below this fraction of the largest are dropped from the
+// warm start (their directions change F by ~1e-6 of it).
+constexpr double kRankTolerance = 1e-3;
+
+bool Binary(const MeasurementWeights& w, double tolerance) {
+  return std::all_of(w.begin(), w.end(),
+                     [&](double x) { return std::min(x, 1 - x) <= tolerance; });
+}
+
+// Verdicts, counts and diagnostics at `poses` for the final `weights` and
+// the rounded inlier set `accepted`.
+void FillEdges(const PoseGraph& graph, const Poses& poses,
+               const MeasurementWeights& weights,
+               const std::vector<char>& known,
+               const std::vector<char>& accepted, double c2,
+               RobustSolverSummary* s) {
+  const size_t m = graph.measurements.size();
+  const std::vector<double> f = Costs(graph, poses);
+  s->edges.assign(m, {});
+  s->outlier_edges.clear();
+  s->num_inliers = s->num_outliers = 0;
+  s->num_rejected_within_threshold = s->num_accepted_beyond_threshold = 0;
+  for (size_t k = 0; k < m; ++k) {
+    const RelativePoseMeasurement& e = graph.measurements[k];
+    const Pose& a = poses[e.i];
+    const Pose& b = poses[e.j];
+    RobustSolverSummary::Edge& edge = s->edges[k];
+    edge.vertex_i = graph.vertex_ids.empty() ? e.i : graph.vertex_ids[e.i];
+    edge.vertex_j = graph.vertex_ids.empty() ? e.j : graph.vertex_ids[e.j];
+    edge.weight = weights.empty() ? 1.0 : weights[k];
+    edge.inlier = accepted[k];
+    edge.known_inlier = known[k];
+    edge.cost = f[k];
+    edge.rotation_residual_deg =
+        RotationAngle(e.R.transpose() * a.R.transpose() * b.R) * (180 / kPi);
+    edge.translation_residual = (b.t - a.t - a.R * e.t).norm();
+    if (edge.inlier) {
+      ++s->num_inliers;
+      if (!edge.known_inlier && f[k] > c2) ++s->num_accepted_beyond_threshold;
+    } else {
+      ++s->num_outliers;
+      s->outlier_edges.push_back(static_cast<int>(k));
+      if (f[k] <= c2) ++s->num_rejected_within_threshold;
+    }
+  }
+}
+
+// The weighted problem GNC solves next: a Staircase over the measurements
+// of its sparsity pattern. Re-weighting keeps the pattern (values only,
+// symbolic analyses reused: Staircase::Reweight) while it holds every
+// positively weighted measurement and few zero-weight ones. Otherwise the
+// problem is rebuilt on the subgraph of positive weights: a zero-weight
+// measurement contributes nothing but fill, and random wrong loop closures
+// fill the factors badly (intel with 50% of its closures wrong: 9x the
+// Cholesky entries of the clean graph's factor, city10000 57x).
+class WeightedProblem {
+ public:
+  // Rebuild when more than this fraction of the pattern has weight 0.
+  static constexpr double kShedFraction = 0.01;
+
+  WeightedProblem(const PoseGraph& graph, const SolverOptions& options)
+      : graph_(graph), options_(options) {}
+
+  // The first problem: the whole graph, every weight 1.
+  void Start(Clock::time_point start) {
+    staircase_ = std::make_unique<internal::Staircase>(graph_, options_,
+                                                       &summary_, start);
+  }
+
+  // The problem with `weights` (one per graph measurement) for the next
+  // solve; false with a message if they leave the graph disconnected.
+  bool SetWeights(const MeasurementWeights& weights, std::string* message) {
+    if (!internal::CheckMeasurementWeights(graph_, weights, message)) {
+      return false;
+    }
+    const size_t m = graph_.measurements.size();
+    const size_t pattern = index_.empty() ? m : index_.size();
+    size_t positive = 0, zero_in_pattern = 0;
+    for (double w : weights) positive += w > 0;
+    MeasurementWeights restricted(pattern);
+    for (size_t q = 0; q < pattern; ++q) {
+      restricted[q] = weights[index_.empty() ? q : index_[q]];
+      zero_in_pattern += restricted[q] == 0;
+    }
+    const bool covers = pattern - zero_in_pattern == positive;
+    if (covers && zero_in_pattern <= kShedFraction * pattern) {
+      if (staircase_->Reweight(std::move(restricted))) return true;
+      *message = summary_.message;
+      return false;
+    }
+    // Rebuild on the positive subgraph (the Staircase first: it refers to
+    // the subgraph).
+    staircase_.reset();
+    if (sub_.measurements.empty() && sub_.num_poses == 0) {
+      sub_ = graph_;  // Poses, ids, initial poses and FIX: Round()'s gauge.
+    }
+    sub_.measurements.clear();
+    index_.clear();
+    MeasurementWeights sub_weights;
+    bool all_one = true;
+    for (size_t k = 0; k < m; ++k) {
+      if (!(weights[k] > 0)) continue;
+      index_.push_back(static_cast<int>(k));
+      sub_.measurements.push_back(graph_.measurements[k]);
+      sub_weights.push_back(weights[k]);
+      all_one = all_one && weights[k] == 1;
+    }
+    if (all_one) sub_weights.clear();
+    staircase_ = std::make_unique<internal::Staircase>(
+        sub_, options_, &summary_, Clock::now(), std::move(sub_weights));
+    ++rebuilds_;
+    if (staircase_->ok()) return true;
+    *message = summary_.message;
+    return false;
+  }
+
+  internal::Staircase& staircase() { return *staircase_; }
+  const SolverSummary& summary() const { return summary_; }
+  int rebuilds() const { return rebuilds_; }
+
+ private:
+  const PoseGraph& graph_;
+  const SolverOptions& options_;
+  PoseGraph sub_;           // The pattern's measurements, once rebuilt.
+  std::vector<int> index_;  // Pattern measurement -> graph's (empty: all).
+  std::unique_ptr<internal::Staircase> staircase_;
+  SolverSummary summary_;
+  int rebuilds_ = 0;
+};
+
+std::string CheckOptions(const RobustSolverOptions& o, int d) {
+  if (!std::isfinite(o.inlier_threshold)) {
+    return "inlier_threshold must be finite";
+  }
+  if (o.inlier_threshold <= 0 &&
+      !(o.inlier_probability > 0 && o.inlier_probability < 1)) {
+    return "inlier_probability must be in (0, 1)";
+  }
+  if (!(o.mu_step > 1) || !std::isfinite(o.mu_step)) {
+    return "mu_step must be a finite number > 1";
+  }
+  if (o.max_iterations < 0) return "max_iterations must be >= 0";
+  if (o.initial_max_rank < 0) return "initial_max_rank must be >= 0";
+  if (o.gnc_threshold_fractions.empty()) {
+    return "gnc_threshold_fractions must not be empty";
+  }
+  for (double fraction : o.gnc_threshold_fractions) {
+    if (!(fraction > 0 && fraction <= 1)) {
+      return "gnc_threshold_fractions must be in (0, 1]";
+    }
+  }
+  if (o.max_consistency_rounds < 0) {
+    return "max_consistency_rounds must be >= 0";
+  }
+  if (!(o.weight_tolerance >= 0 && o.weight_tolerance < 0.5)) {
+    return "weight_tolerance must be in [0, 0.5)";
+  }
+  if (!(o.relative_cost_tolerance >= 0)) {
+    return "relative_cost_tolerance must be >= 0";
+  }
+  if (d != 2 && d != 3) return "dimension must be 2 or 3";
+  return "";
+}
+
+}  // namespace
+
+bool IsOdometry(const RelativePoseMeasurement& measurement) {
+  return std::abs(measurement.j - measurement.i) == 1;
+}
+
+double InlierThreshold(const RobustSolverOptions& options, int dimension) {
+  if (!CheckOptions(options, dimension).empty()) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  if (options.inlier_threshold > 0) return options.inlier_threshold;
+  return internal::ChiSquareQuantile(options.inlier_probability,
+                                     dimension * (dimension + 1) / 2);
+}
+
+namespace {
+
+// One GNC schedule from the first solve's result, with its final inlier
+// problem and consistency rounds.
+struct GncRun {
+  RobustSolverSummary::Run record;
+  RobustSolverSummary::Status status = RobustSolverSummary::Status::kConverged;
+  std::string message;
+  Poses poses;
+  MeasurementWeights weights;
+  std::vector<char> accepted;
+  std::vector<RobustSolverSummary::Iteration> history;
+  SolverSummary inlier_summary;
+  bool weights_binary = false;
+};
+
+// sum_k min(f_k, c^2) over the estimated measurements plus f_k of the known
+// inliers, at `poses`.
+double TlsCost(const std::vector<double>& f, const std::vector<char>& known,
+               double c2) {
+  double cost = 0;
+  for (size_t k = 0; k < f.size(); ++k) {
+    cost += known[k] ? f[k] : std::min(f[k], c2);
+  }
+  return cost;
+}
+
+}  // namespace
+
+Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
+                  RobustSolverSummary* summary) {
+  const auto start = Clock::now();
+  RobustSolverSummary& s = *summary;
+  s = RobustSolverSummary();
+  const int d = graph.dimension;
+  const size_t m = graph.measurements.size();
+  s.dimension = d;
+  s.num_poses = graph.num_poses;
+  s.num_measurements = static_cast<int>(m);
+  auto finish = [&](RobustSolverSummary::Status status, Poses poses) {
+    s.status = status;
+    s.total_time_s = Seconds(start);
+    return poses;
+  };
+  s.message = CheckOptions(options, d);
+  if (!s.message.empty()) {
+    s.message = "robust solver options: " + s.message;
+    return finish(RobustSolverSummary::Status::kInvalidInput, {});
+  }
+  if (graph.num_landmarks > 0 || !graph.priors.empty()) {
+    s.message =
+        "the robust solve does not support landmarks or priors yet (their "
+        "terms would need weights of their own)";
+    return finish(RobustSolverSummary::Status::kInvalidInput, {});
+  }
+  const double c2 = InlierThreshold(options, d);
+  s.inlier_threshold = c2;
+
+  // The first solve is Solve() itself (up to initial_max_rank). GNC's
+  // weighted solves then prove their certificates in double only (they
+  // decide saddle escapes; no bound of theirs is reported); each final
+  // inlier problem's proof uses the caller's arithmetic again. The
+  // Staircase reads its options at every stage.
+  SolverOptions solve_options = options.solver_options;
+  const int r0 = options.solver_options.initial_rank > 0
+                     ? options.solver_options.initial_rank
+                     : d + 2;
+  if (options.initial_max_rank > 0) {
+    solve_options.max_rank = std::min(options.solver_options.max_rank,
+                                      std::max(options.initial_max_rank, r0));
+  }
+  WeightedProblem problem(graph, solve_options);
+  problem.Start(start);
+  auto invalid = [&]() {
+    s.message = problem.summary().message;
+    s.initial_summary = problem.summary();
+    return finish(RobustSolverSummary::Status::kInvalidInput, {});
+  };
+  if (!problem.staircase().ok()) return invalid();
+  std::vector<char> known(m, 0);
+  for (size_t k = 0; k < m; ++k) {
+    known[k] =
+        options.known_inliers == RobustSolverOptions::KnownInliers::kOdometry &&
+        IsOdometry(graph.measurements[k]);
+  }
+  if (problem.staircase().trivial()) {  // One pose, no measurements.
+    s.initial_summary = s.inlier_summary = problem.summary();
+    s.weights_binary = true;
+    return finish(RobustSolverSummary::Status::kConverged,
+                  problem.staircase().Trivial().poses);
+  }
+  Eigen::MatrixXd Y0;
+  if (!problem.staircase().Initialize(nullptr, &Y0)) return invalid();
+  problem.staircase().Run(&Y0);
+  Poses poses0 = problem.staircase().Round(Y0).poses;
+  const std::vector<double> f0 = Costs(graph, poses0);
+  double max_cost = 0;
+  for (size_t k = 0; k < m; ++k) {
+    if (!known[k]) max_cost = std::max(max_cost, f0[k]);
+  }
+  solve_options.max_rank = options.solver_options.max_rank;
+  if (max_cost <= c2) {
+    // Every measurement fits: this is the inlier problem. The staircase
+    // continues where a rank cap stopped it (as Solve() would).
+    if (problem.summary().status == SolverSummary::Status::kMaxRankReached &&
+        problem.summary().final_rank < solve_options.max_rank) {
+      problem.staircase().Run(&Y0);
+      poses0 = problem.staircase().Round(Y0).poses;
+    }
+    problem.staircase().Report(Y0, Solution{poses0, {}});
+    s.initial_summary = s.inlier_summary = problem.summary();
+    s.initial_time_s = s.total_time_s = Seconds(start);
+    s.weights_binary = true;
+    FillEdges(graph, poses0, MeasurementWeights(m, 1.0), known,
+              std::vector<char>(m, 1), c2, &s);
+    return finish(RobustSolverSummary::Status::kConverged, poses0);
+  }
+  problem.staircase().Report(Y0, Solution{poses0, {}});
+  s.initial_summary = problem.summary();
+  s.initial_time_s = Seconds(start);
+  const double g0 = options.gnc_threshold_fractions[0] * c2;
+  s.initial_mu = g0 / (2 * max_cost - g0);
+
+  // GNC (Yang et al. 2020, Algorithm 1 with TLS) as in GTSAM's
+  // GncOptimizer, from the first solve, at GNC threshold g2: weights from
+  // the last estimate, weighted solve warm-started from the last factor
+  // (its negligible directions dropped), mu update, convergence test; then
+  // the accepted set's problem, certified, and the consistency rounds at c^2.
+  auto run_gnc = [&](double fraction) {
+    const auto run_start = Clock::now();
+    GncRun run;
+    run.record.gnc_threshold = fraction * c2;
+    const double g2 = run.record.gnc_threshold;
+    Eigen::MatrixXd Y = Y0;
+    run.poses = poses0;
+    std::vector<double> f = f0;
+    run.weights.assign(m, 1.0);  // Of the last solved problem.
+    bool reported = true;        // The first solve was reported.
+    std::string message;
+    double mu = g2 / (2 * max_cost - g2);
+    auto surrogate = [&](double mu_k) {
+      double cost = 0;
+      for (size_t k = 0; k < m; ++k) {
+        cost += known[k] ? f[k] : TlsSurrogate(f[k], mu_k, g2);
+      }
+      return cost;
+    };
+    auto disconnected = [&](const std::string& what) {
+      run.status = RobustSolverSummary::Status::kInlierGraphDisconnected;
+      run.message = what + message;
+      run.record.time_s = Seconds(run_start);
+      return run;
+    };
+    double previous_cost = surrogate(mu);
+    run.status = RobustSolverSummary::Status::kMaxIterations;
+    solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
+    for (int it = 0; it < options.max_iterations; ++it) {
+      const auto step_start = Clock::now();
+      MeasurementWeights next(m);
+      for (size_t k = 0; k < m; ++k) {
+        next[k] = known[k] ? 1.0 : TlsWeight(f[k], mu, g2);
+      }
+      if (!problem.SetWeights(next, &message)) {
+        run.accepted.assign(m, 0);
+        for (size_t k = 0; k < m; ++k) run.accepted[k] = next[k] > 0.5;
+        run.weights = next;
+        return disconnected("GNC step " + std::to_string(it + 1) + ": ");
+      }
+      run.weights = std::move(next);
+      Y = ReduceRank(Y, d, r0, kRankTolerance);
+      problem.staircase().Run(&Y);
+      run.poses = problem.staircase().Round(Y).poses;
+      reported = false;
+      f = Costs(graph, run.poses);
+      const double cost = surrogate(mu);
+      const SolverSummary& solve = problem.summary();
+      RobustSolverSummary::Iteration record;
+      record.mu = mu;
+      record.surrogate_cost = cost;
+      for (double w : run.weights) {
+        record.num_zero_weights += w == 0;
+        record.num_unit_weights += w == 1;
+      }
+      record.status = solve.status;
+      record.rank = solve.final_rank;
+      record.solver_iterations = solve.iterations;
+      record.optimization_time_s = solve.optimization_time_s;
+      record.verification_time_s = solve.verification_time_s;
+      record.time_s = Seconds(step_start);
+      run.history.push_back(record);
+      run.record.iterations = it + 1;
+      mu *= options.mu_step;
+      if (Binary(run.weights, options.weight_tolerance) ||
+          std::abs(cost - previous_cost) <=
+              options.relative_cost_tolerance * previous_cost) {
+        run.status = RobustSolverSummary::Status::kConverged;
+        break;
+      }
+      previous_cost = cost;
+    }
+    run.weights_binary = Binary(run.weights, options.weight_tolerance);
+
+    // The problem restricted to the accepted measurements (weights rounded
+    // at 1/2), solved from the last factor, proven in the caller's
+    // arithmetic.
+    solve_options.proof_arithmetic = options.solver_options.proof_arithmetic;
+    run.accepted.assign(m, 0);
+    for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
+    auto solve_accepted = [&]() {
+      MeasurementWeights binary(m);
+      for (size_t k = 0; k < m; ++k) binary[k] = run.accepted[k] ? 1.0 : 0.0;
+      if (!problem.SetWeights(binary, &message)) return false;
+      Y = ReduceRank(Y, d, r0, kRankTolerance);
+      problem.staircase().Run(&Y);
+      run.poses = problem.staircase().Round(Y).poses;
+      reported = false;
+      return true;
+    };
+    bool binary = true;
+    for (size_t k = 0; k < m; ++k) {
+      binary = binary && run.weights[k] == run.accepted[k];
+    }
+    // A new solve unless the last one was this problem already, proven in
+    // the caller's arithmetic (GNC steps prove in double).
+    if ((!binary || (run.record.iterations > 0 &&
+                     options.solver_options.proof_arithmetic !=
+                         SolverOptions::ProofArithmetic::kDouble)) &&
+        !solve_accepted()) {
+      return disconnected("the accepted measurements: ");
+    }
+    // Consistency at c^2: accept exactly the measurements within it at the
+    // inlier problem's optimum. Each change lowers the TLS cost (at fixed
+    // poses the new set takes min(f_k, c^2) per measurement; the re-solve
+    // lowers the accepted sum), so the rounds end.
+    for (int round = 0; round < options.max_consistency_rounds; ++round) {
+      f = Costs(graph, run.poses);
+      bool changed = false;
+      for (size_t k = 0; k < m; ++k) {
+        if (known[k] || run.accepted[k] == (f[k] <= c2)) continue;
+        run.accepted[k] = f[k] <= c2;
+        changed = true;
+      }
+      if (!changed) break;
+      ++run.record.consistency_rounds;
+      if (!solve_accepted()) {
+        return disconnected("consistency round " + std::to_string(round + 1) +
+                            ": ");
+      }
+    }
+    if (!reported) problem.staircase().Report(Y, Solution{run.poses, {}});
+    run.inlier_summary = problem.summary();
+    f = Costs(graph, run.poses);
+    run.record.tls_cost = TlsCost(f, known, c2);
+    for (char a : run.accepted) run.record.num_outliers += !a;
+    run.record.certified = run.inlier_summary.certified();
+    run.record.time_s = Seconds(run_start);
+    return run;
+  };
+
+  // Every schedule; the lowest TLS cost at c^2 wins (the first on ties).
+  const auto gnc_start = Clock::now();
+  GncRun best;
+  int best_index = -1;
+  for (size_t q = 0; q < options.gnc_threshold_fractions.size(); ++q) {
+    GncRun run = run_gnc(options.gnc_threshold_fractions[q]);
+    run.record.status = run.status;
+    s.runs.push_back(run.record);
+    const bool usable =
+        run.status != RobustSolverSummary::Status::kInlierGraphDisconnected;
+    const bool best_usable =
+        best_index >= 0 &&
+        best.status != RobustSolverSummary::Status::kInlierGraphDisconnected;
+    if (best_index < 0 ||
+        (usable &&
+         (!best_usable || run.record.tls_cost < best.record.tls_cost))) {
+      best = std::move(run);
+      best_index = static_cast<int>(q);
+    }
+  }
+  s.gnc_time_s = Seconds(gnc_start);
+  s.selected_run = best_index;
+  s.gnc_threshold = best.record.gnc_threshold;
+  s.iterations = best.record.iterations;
+  s.consistency_rounds = best.record.consistency_rounds;
+  s.history = std::move(best.history);
+  if (!s.history.empty()) s.initial_mu = s.history[0].mu;
+  s.weights_binary = best.weights_binary;
+  s.message = best.message;
+  s.inlier_summary = best.inlier_summary;
+  s.pattern_rebuilds = problem.rebuilds();
+  FillEdges(graph, best.poses, best.weights, known, best.accepted, c2, &s);
+  return finish(best.status, std::move(best.poses));
+}
+
+bool RobustSolverSummary::certified() const {
+  return (status == Status::kConverged || status == Status::kMaxIterations) &&
+         inlier_summary.certified();
+}
+
+std::string RobustSolverSummary::StatusString() const {
+  switch (status) {
+    case Status::kConverged:
+      return "CONVERGED";
+    case Status::kMaxIterations:
+      return "MAX_ITERATIONS";
+    case Status::kInlierGraphDisconnected:
+      return "INLIER_GRAPH_DISCONNECTED";
+    case Status::kInvalidInput:
+      return "INVALID_INPUT";
+  }
+  return "UNKNOWN";
+}
+
+std::string RobustSolverSummary::BriefReport() const {
+  char buf[768];
+  if (status == Status::kInvalidInput ||
+      status == Status::kInlierGraphDisconnected) {
+    std::snprintf(buf, sizeof(buf), "SE-Sync GNC-TLS: %s: %s",
+                  StatusString().c_str(), message.c_str());
+    return buf;
+  }
+  std::snprintf(
+      buf, sizeof(buf),
+      "SE-Sync GNC-TLS: %s after %d GNC iterations, %d of %d measurements "
+      "rejected (c^2 = %.4g); the optimum of the problem restricted to the "
+      "accepted edges is %s: %s, F = %.10g, relative suboptimality <= "
+      "%.2e, %.3f s",
+      StatusString().c_str(), iterations, num_outliers, num_measurements,
+      inlier_threshold,
+      inlier_summary.certified() ? "certified" : "NOT certified",
+      inlier_summary.StatusString().c_str(), inlier_summary.objective,
+      inlier_summary.relative_suboptimality_bound, total_time_s);
+  return buf;
+}
+
+std::string RobustSolverSummary::FullReport(bool all_edges) const {
+  std::string out;
+  char buf[512];
+  auto line = [&](const char* format, auto... args) {
+    std::snprintf(buf, sizeof(buf), format, args...);
+    out += buf;
+  };
+  out +=
+      "\nSE-Sync GNC-TLS Robust Solver Report\n"
+      "------------------------------------\n";
+  line("%-34s %d\n", "Dimension", dimension);
+  line("%-34s %d\n", "Poses", num_poses);
+  line("%-34s %d\n", "Measurements", num_measurements);
+  if (status == Status::kInvalidInput) {
+    line("%-34s %s\n", "Error", message.c_str());
+    return out;
+  }
+  line("%-34s %.6g\n", "TLS threshold c^2 on f_k", inlier_threshold);
+  out += "\nFirst solve (all weights 1: plain SE-Sync)\n";
+  line("  %s\n", initial_summary.BriefReport().c_str());
+  out += "\nGraduated non-convexity: runs (the lowest TLS cost is kept)\n";
+  line("  %4s %11s %24s %6s %6s %9s %18s %9s %9s\n", "run", "GNC c^2", "status",
+       "iters", "rounds", "rejected", "TLS cost at c^2", "certified",
+       "time [s]");
+  for (size_t q = 0; q < runs.size(); ++q) {
+    const Run& r = runs[q];
+    RobustSolverSummary status_only;
+    status_only.status = r.status;
+    line("  %4d %11.4g %24s %6d %6d %9d %18.10g %9s %9.3f%s\n",
+         static_cast<int>(q + 1), r.gnc_threshold,
+         status_only.StatusString().c_str(), r.iterations, r.consistency_rounds,
+         r.num_outliers, r.tls_cost, r.certified ? "yes" : "no", r.time_s,
+         static_cast<int>(q) == selected_run ? "  <- selected" : "");
+  }
+  out += "\nSelected run's GNC steps\n";
+  line("%-34s %.3e\n", "Initial mu", initial_mu);
+  line("  %4s %11s %18s %8s %8s %5s %9s %s\n", "iter", "mu", "surrogate",
+       "w = 0", "w = 1", "rank", "time [s]", "solve");
+  for (size_t t = 0; t < history.size(); ++t) {
+    const Iteration& h = history[t];
+    SolverSummary status_only;
+    status_only.status = h.status;
+    line("  %4d %11.4e %18.10g %8d %8d %5d %9.4f %s\n", static_cast<int>(t + 1),
+         h.mu, h.surrogate_cost, h.num_zero_weights, h.num_unit_weights, h.rank,
+         h.time_s, status_only.StatusString().c_str());
+  }
+  line("%-34s %s\n", "Final weights binary", weights_binary ? "yes" : "no");
+  line("%-34s %d accepted, %d rejected\n", "Measurements", num_inliers,
+       num_outliers);
+  line("%-34s %d\n", "Consistency rounds", consistency_rounds);
+  line("%-34s %d rejected with f_k <= c^2, %d accepted with f_k > c^2\n",
+       "Consistency at the result", num_rejected_within_threshold,
+       num_accepted_beyond_threshold);
+  line("%-34s %d\n", "Sparsity pattern rebuilds", pattern_rebuilds);
+  if (status == Status::kInlierGraphDisconnected) {
+    line("\n%-34s %s\n", "Status", StatusString().c_str());
+    line("%-34s %s\n", "", message.c_str());
+    return out;
+  }
+  out += "\nProblem restricted to the accepted edges";
+  out += inlier_summary.FullReport();
+  out += "\nPer-edge verdicts";
+  out += all_edges ? " (all)\n" : " (rejected)\n";
+  line("  %8s %10s %10s %9s %12s %12s %12s %s\n", "edge", "vertex i",
+       "vertex j", "weight", "rot. [deg]", "trans.", "f_k", "verdict");
+  for (size_t k = 0; k < edges.size(); ++k) {
+    const Edge& e = edges[k];
+    if (!all_edges && e.inlier) continue;
+    line("  %8d %10lld %10lld %9.3g %12.4g %12.4g %12.4g %s\n",
+         static_cast<int>(k), static_cast<long long>(e.vertex_i),
+         static_cast<long long>(e.vertex_j), e.weight, e.rotation_residual_deg,
+         e.translation_residual, e.cost,
+         e.inlier ? (e.known_inlier ? "inlier (known)" : "inlier") : "outlier");
+  }
+  out += "\nTime (seconds)\n";
+  line("%-34s %.4f\n", "  First solve", initial_time_s);
+  line("%-34s %.4f\n", "  GNC iterations", gnc_time_s);
+  line("%-34s %.4f\n", "  Inlier problem", inlier_time_s);
+  line("%-34s %.4f\n", "Total", total_time_s);
+  line("\n%-34s %s\n", "Status", StatusString().c_str());
+  line(
+      "%-34s the optimum of the problem restricted to the accepted edges is "
+      "%s (%s); this is not a certificate for the TLS problem\n",
+      "", inlier_summary.certified() ? "certified" : "not certified",
+      inlier_summary.StatusString().c_str());
+  return out;
+}
+
+}  // namespace ceres_sesync

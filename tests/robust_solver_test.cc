@@ -1,0 +1,346 @@
+// The outlier-robust solve (robust_solver.h): exact recovery on noiseless
+// data with wrong loop closures, equality with Solve() without outliers,
+// binary weights, determinism, the disconnected-inlier status; the
+// chi-square threshold; the Ceres robust-loss baselines on the same terms.
+
+#include "ceres_sesync/robust_solver.h"
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "ceres_sesync/ceres_baseline.h"
+#include "ceres_sesync/cube_generator.h"
+#include "ceres_sesync/internal/chi_square.h"
+#include "ceres_sesync/outlier_generator.h"
+#include "ceres_sesync/sesync_solver.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/util/test_graphs.h"
+
+namespace ceres_sesync {
+namespace {
+
+using test_util::RandomGraphOptions;
+
+PoseGraph ChainGraph(int d, int n, int loops, bool noiseless, uint64_t seed,
+                     Poses* truth) {
+  RandomGraphOptions o;
+  o.dimension = d;
+  o.num_poses = n;
+  o.num_loop_closures = loops;
+  o.chain = true;
+  o.noiseless = noiseless;
+  o.kappa = 100;
+  o.tau = 100;
+  o.seed = seed;
+  return test_util::RandomPoseGraph(o, truth);
+}
+
+RobustSolverOptions Options() {
+  RobustSolverOptions options;
+  options.solver_options.num_threads = 1;
+  return options;
+}
+
+double Sum(const RobustSolverSummary& s) {
+  double f = 0;
+  for (const RobustSolverSummary::Edge& e : s.edges) f += e.cost;
+  return f;
+}
+
+TEST(ChiSquare, QuantilesMatchTables) {
+  // Abramowitz & Stegun, Table 26.8.
+  EXPECT_NEAR(internal::ChiSquareQuantile(0.95, 1), 3.841459, 1e-6);
+  EXPECT_NEAR(internal::ChiSquareQuantile(0.99, 2), 9.210340, 1e-6);
+  EXPECT_NEAR(internal::ChiSquareQuantile(0.999, 3), 16.266236, 1e-6);
+  EXPECT_NEAR(internal::ChiSquareQuantile(0.99, 6), 16.811894, 1e-6);
+  EXPECT_NEAR(internal::ChiSquareQuantile(0.5, 4), 3.356694, 1e-6);
+  for (int k = 1; k <= 7; ++k) {
+    for (double p : {1e-6, 0.3, 0.999999}) {
+      EXPECT_NEAR(internal::ChiSquareCdf(internal::ChiSquareQuantile(p, k), k),
+                  p, 1e-12);
+    }
+  }
+  EXPECT_TRUE(std::isnan(internal::ChiSquareQuantile(1.0, 3)));
+  RobustSolverOptions o;
+  EXPECT_NEAR(InlierThreshold(o, 2), 30.664850, 1e-5);  // chi^2(3)
+  EXPECT_NEAR(InlierThreshold(o, 3), 38.258336, 1e-5);  // chi^2(6)
+  o.inlier_threshold = 7;
+  EXPECT_EQ(InlierThreshold(o, 3), 7);
+}
+
+// Noiseless measurements plus random wrong loop closures: the ground truth
+// exactly, every outlier flagged and nothing else, weights binary, the
+// inlier problem certified (F = 0).
+TEST(RobustSolver, NoiselessDataWithOutliersRecoversGroundTruthExactly) {
+  for (int d : {2, 3}) {
+    for (double fraction : {0.3, 0.6}) {
+      Poses truth;
+      const PoseGraph clean = ChainGraph(d, 40, 40, true, 7 + d, &truth);
+      OutlierOptions o;
+      o.fraction = fraction;
+      o.seed = 3;
+      PoseGraph corrupted;
+      std::vector<int> added;
+      ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+      ASSERT_GT(added.size(), 10u);
+      RobustSolverSummary s;
+      const Poses poses = SolveRobust(corrupted, Options(), &s);
+      ASSERT_TRUE(s.certified()) << s.FullReport();
+      EXPECT_EQ(s.outlier_edges, added) << s.FullReport();
+      EXPECT_EQ(s.num_outliers, static_cast<int>(added.size()));
+      EXPECT_TRUE(s.weights_binary);
+      EXPECT_LT(test_util::GaugeInvariantPoseDistance(poses, truth), 1e-6);
+      EXPECT_LT(s.inlier_summary.objective, 1e-12);
+      EXPECT_EQ(s.num_rejected_within_threshold, 0);
+      EXPECT_EQ(s.num_accepted_beyond_threshold, 0);
+      EXPECT_GT(s.iterations, 0);
+      for (size_t k = 0; k < s.edges.size(); ++k) {
+        EXPECT_EQ(s.edges[k].known_inlier,
+                  IsOdometry(corrupted.measurements[k]));
+        if (s.edges[k].known_inlier) {
+          EXPECT_EQ(s.edges[k].weight, 1);
+        }
+      }
+    }
+  }
+}
+
+// Without outliers the robust solve is Solve(): same poses (bitwise), same
+// certificate, nothing rejected, no GNC step.
+TEST(RobustSolver, WithoutOutliersEqualsSolve) {
+  CubeOptions cube;
+  cube.side = 4;
+  cube.seed = 5;
+  PoseGraph cube_graph;
+  ASSERT_TRUE(GenerateCube(cube, &cube_graph, nullptr, nullptr));
+  for (const PoseGraph& graph :
+       {cube_graph, ChainGraph(2, 50, 30, false, 2, nullptr)}) {
+    RobustSolverOptions options = Options();
+    SolverSummary plain;
+    const Poses expected = Solve(graph, options.solver_options, &plain);
+    ASSERT_TRUE(plain.certified());
+    RobustSolverSummary s;
+    const Poses poses = SolveRobust(graph, options, &s);
+    EXPECT_EQ(s.status, RobustSolverSummary::Status::kConverged);
+    EXPECT_TRUE(s.certified());
+    EXPECT_EQ(s.num_outliers, 0);
+    EXPECT_EQ(s.iterations, 0);
+    EXPECT_EQ(s.inlier_summary.objective, plain.objective);
+    EXPECT_EQ(s.inlier_summary.lower_bound, plain.lower_bound);
+    ASSERT_EQ(poses.size(), expected.size());
+    for (size_t i = 0; i < poses.size(); ++i) {
+      EXPECT_EQ(poses[i].R, expected[i].R);
+      EXPECT_EQ(poses[i].t, expected[i].t);
+    }
+    // The verdicts' costs are the terms of F.
+    EXPECT_NEAR(Sum(s), plain.objective, 1e-9 * plain.objective);
+  }
+}
+
+// Noisy data with outliers: the weights end binary and the verdicts follow
+// them; the outliers are exactly the added measurements.
+TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
+  for (int d : {2, 3}) {
+    const PoseGraph clean = ChainGraph(d, 60, 60, false, 11, nullptr);
+    OutlierOptions o;
+    o.fraction = 0.4;
+    o.seed = 1;
+    PoseGraph corrupted;
+    std::vector<int> added;
+    ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+    RobustSolverSummary s;
+    SolveRobust(corrupted, Options(), &s);
+    ASSERT_EQ(s.status, RobustSolverSummary::Status::kConverged)
+        << s.FullReport();
+    EXPECT_TRUE(s.weights_binary);
+    for (const RobustSolverSummary::Edge& e : s.edges) {
+      EXPECT_LE(std::min(e.weight, 1 - e.weight), 1e-4);
+      if (s.consistency_rounds == 0) {
+        EXPECT_EQ(e.inlier, e.weight > 0.5);
+      }
+    }
+    EXPECT_EQ(s.outlier_edges, added);
+    EXPECT_TRUE(s.certified()) << s.FullReport();
+    ASSERT_FALSE(s.runs.empty());
+    ASSERT_GE(s.selected_run, 0);
+    for (const RobustSolverSummary::Run& r : s.runs) {
+      EXPECT_GE(r.tls_cost, s.runs[s.selected_run].tls_cost);
+    }
+  }
+}
+
+// The same input and options (thread count included) give the same result,
+// bitwise; so do 1 and 2 threads (the kernels' results do not depend on
+// the thread count).
+TEST(RobustSolver, DeterministicForSeedAndThreads) {
+  const PoseGraph clean = ChainGraph(3, 40, 30, false, 4, nullptr);
+  OutlierOptions o;
+  o.fraction = 0.3;
+  o.seed = 9;
+  PoseGraph corrupted;
+  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, nullptr, nullptr));
+  RobustSolverOptions options = Options();
+  RobustSolverSummary a, b, c;
+  const Poses pa = SolveRobust(corrupted, options, &a);
+  const Poses pb = SolveRobust(corrupted, options, &b);
+  options.solver_options.num_threads = 2;
+  const Poses pc = SolveRobust(corrupted, options, &c);
+  for (const auto* other : {&b, &c}) {
+    EXPECT_EQ(a.outlier_edges, other->outlier_edges);
+    EXPECT_EQ(a.iterations, other->iterations);
+    EXPECT_EQ(a.inlier_summary.objective, other->inlier_summary.objective);
+    ASSERT_EQ(a.edges.size(), other->edges.size());
+    for (size_t k = 0; k < a.edges.size(); ++k) {
+      EXPECT_EQ(a.edges[k].weight, other->edges[k].weight);
+    }
+  }
+  for (const Poses* other : {&pb, &pc}) {
+    ASSERT_EQ(pa.size(), other->size());
+    for (size_t i = 0; i < pa.size(); ++i) {
+      EXPECT_EQ(pa[i].R, (*other)[i].R);
+      EXPECT_EQ(pa[i].t, (*other)[i].t);
+    }
+  }
+}
+
+// Two clusters joined only by two contradicting measurements, neither of
+// them odometry: the graph is connected, but both bridges are rejected
+// (accepting them costs far more than c^2 each), which would disconnect the
+// accepted graph: a clear status, no crash, no certificate.
+TEST(RobustSolver, InlierSetThatDisconnectsTheGraphGetsAClearStatus) {
+  for (int d : {2, 3}) {
+    Poses truth;
+    PoseGraph a = ChainGraph(d, 10, 12, true, 21, &truth);
+    Poses truth_b;
+    const PoseGraph b = ChainGraph(d, 10, 12, true, 22, &truth_b);
+    // Poses 10..19 are b's, shifted.
+    PoseGraph graph = a;
+    graph.initial_poses.clear();
+    for (int k = 10; k < 20; ++k) graph.AddVertex(k);
+    for (RelativePoseMeasurement e : b.measurements) {
+      e.i += 10;
+      e.j += 10;
+      graph.measurements.push_back(e);
+    }
+    // Bridges (4, 14): a relative pose turned by +-60 degrees about the
+    // same axis. Their rotation terms add up to one term for the unturned
+    // pose (R + R^T = I in the plane of the turn), so the least-squares fit
+    // is that pose and both residuals are equal: 4 kappa (1 - cos 60) = 200
+    // each, far above c^2.
+    Eigen::MatrixXd turn = Eigen::MatrixXd::Identity(d, d);
+    turn(0, 0) = turn(1, 1) = 0.5;
+    turn(0, 1) = -std::sqrt(0.75);
+    turn(1, 0) = std::sqrt(0.75);
+    for (bool inverse : {false, true}) {
+      RelativePoseMeasurement e;
+      e.i = 4;
+      e.j = 14;
+      e.R = inverse ? Eigen::MatrixXd(turn.transpose()) : turn;
+      e.t = Eigen::VectorXd::Zero(d);
+      e.t(0) = 1;
+      e.kappa = 100;
+      e.tau = 100;
+      graph.measurements.push_back(e);
+    }
+    ASSERT_TRUE(ValidatePoseGraph(graph, nullptr));
+    for (auto known : {RobustSolverOptions::KnownInliers::kOdometry,
+                       RobustSolverOptions::KnownInliers::kNone}) {
+      RobustSolverOptions options = Options();
+      options.known_inliers = known;
+      RobustSolverSummary s;
+      const Poses poses = SolveRobust(graph, options, &s);
+      EXPECT_EQ(s.status, RobustSolverSummary::Status::kInlierGraphDisconnected)
+          << s.FullReport();
+      EXPECT_THAT(s.message, ::testing::HasSubstr("2 components"));
+      EXPECT_FALSE(s.certified());
+      EXPECT_EQ(poses.size(), 20u);  // The last connected step's.
+      EXPECT_EQ(s.edges.size(), graph.measurements.size());
+      EXPECT_THAT(s.FullReport(),
+                  ::testing::HasSubstr("INLIER_GRAPH_DISCONNECTED"));
+    }
+  }
+}
+
+TEST(RobustSolver, InvalidOptionsAndInputsAreReported) {
+  const PoseGraph graph = ChainGraph(2, 10, 5, false, 1, nullptr);
+  RobustSolverSummary s;
+  RobustSolverOptions options = Options();
+  options.mu_step = 1;
+  EXPECT_TRUE(SolveRobust(graph, options, &s).empty());
+  EXPECT_EQ(s.status, RobustSolverSummary::Status::kInvalidInput);
+  EXPECT_THAT(s.message, ::testing::HasSubstr("mu_step"));
+  options = Options();
+  options.inlier_probability = 1;
+  SolveRobust(graph, options, &s);
+  EXPECT_THAT(s.message, ::testing::HasSubstr("inlier_probability"));
+  options = Options();
+  options.gnc_threshold_fractions = {0.1, 2};
+  SolveRobust(graph, options, &s);
+  EXPECT_THAT(s.message, ::testing::HasSubstr("gnc_threshold_fractions"));
+  PoseGraph bad = graph;
+  bad.measurements[3].kappa = -1;
+  SolveRobust(bad, Options(), &s);
+  EXPECT_EQ(s.status, RobustSolverSummary::Status::kInvalidInput);
+  EXPECT_THAT(s.BriefReport(), ::testing::HasSubstr("INVALID_INPUT"));
+}
+
+// Ceres with Huber and Cauchy losses on the same terms: the robust
+// objective it reports is sum_k rho(f_k) at its result, F is eq. (12), and
+// it reduces to least squares without a loss.
+TEST(CeresRobustLoss, LossesAreOnTheMeasurementTerms) {
+  const PoseGraph clean = ChainGraph(3, 30, 20, false, 6, nullptr);
+  OutlierOptions o;
+  o.fraction = 0.2;
+  PoseGraph graph;
+  ASSERT_TRUE(AddOutliers(clean, o, &graph, nullptr, nullptr));
+  const Poses initial = OdometryInitialization(clean);
+  const double a2 = 9;
+  for (auto type : {CeresRobustLoss::Type::kNone, CeresRobustLoss::Type::kHuber,
+                    CeresRobustLoss::Type::kCauchy}) {
+    CeresBaselineOptions options;
+    options.method = CeresBaselineOptions::Method::kLevenbergMarquardt;
+    options.loss.type = type;
+    options.loss.threshold = a2;
+    Poses result;
+    CeresBaselineSummary summary;
+    std::string error;
+    ASSERT_TRUE(
+        SolveWithCeres(graph, initial, options, &result, &summary, &error))
+        << error;
+    double robust = 0;
+    for (const RelativePoseMeasurement& e : graph.measurements) {
+      const Pose& p = result[e.i];
+      const Pose& q = result[e.j];
+      const double s = e.kappa * (q.R - p.R * e.R).squaredNorm() +
+                       e.tau * (q.t - p.t - p.R * e.t).squaredNorm();
+      switch (type) {
+        case CeresRobustLoss::Type::kNone:
+          robust += s;
+          break;
+        case CeresRobustLoss::Type::kHuber:
+          robust += s <= a2 ? s : 2 * std::sqrt(a2 * s) - a2;
+          break;
+        case CeresRobustLoss::Type::kCauchy:
+          robust += a2 * std::log1p(s / a2);
+          break;
+      }
+    }
+    EXPECT_NEAR(summary.final_robust_objective, robust, 1e-8 * robust);
+    EXPECT_NEAR(summary.final_objective, EvaluateObjective(graph, result),
+                1e-9 * summary.final_objective);
+    if (type != CeresRobustLoss::Type::kNone) {
+      EXPECT_LT(summary.final_robust_objective, summary.final_objective);
+    }
+  }
+  CeresBaselineOptions bad;
+  bad.loss.type = CeresRobustLoss::Type::kHuber;
+  std::string error;
+  EXPECT_FALSE(SolveWithCeres(graph, initial, bad, nullptr, nullptr, &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("threshold"));
+}
+
+}  // namespace
+}  // namespace ceres_sesync

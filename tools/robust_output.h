@@ -1,0 +1,35 @@
+// The robust solve's outputs for `ceres_sesync solve --robust`: the
+// --known_inliers flag, the JSON keys and the per-edge CSV report.
+
+#ifndef CERES_SESYNC_TOOLS_ROBUST_OUTPUT_H_
+#define CERES_SESYNC_TOOLS_ROBUST_OUTPUT_H_
+
+#include <string>
+
+#include "ceres_sesync/internal/json_writer.h"
+#include "ceres_sesync/robust_solver.h"
+
+namespace ceres_sesync::tools {
+
+// "odometry" or "none"; false for anything else.
+bool ParseKnownInliers(const std::string& name,
+                       RobustSolverOptions::KnownInliers* known_inliers);
+
+// Adds to the solve's JSON: "robust": true, "robust_status",
+// "inlier_threshold", "gnc_iterations", "consistency_rounds",
+// "num_inliers", "num_outliers", "outlier_edges" (0-based indices of the
+// rejected measurements in the order of the file's EDGE lines) and "edges"
+// (one object per measurement: weight, inlier, known_inlier,
+// rotation_residual_deg, translation_residual, cost).
+void AddRobustJson(const RobustSolverSummary& summary,
+                   internal::JsonWriter* json);
+
+// Writes the per-edge verdicts as CSV (header line, then one line per
+// measurement in file order): edge,vertex_i,vertex_j,weight,inlier,
+// known_inlier,rotation_residual_deg,translation_residual,cost. Atomic.
+bool WriteEdgeReport(const std::string& path,
+                     const RobustSolverSummary& summary, std::string* error);
+
+}  // namespace ceres_sesync::tools
+
+#endif  // CERES_SESYNC_TOOLS_ROBUST_OUTPUT_H_
