@@ -186,61 +186,193 @@ int64_t SparseCholeskyFactor::memory_bytes() const {
              sizeof(int);
 }
 
-// Column j of W is the r-vector w_j. Forward, L Z = W^T by supernodes:
-// within the c columns of a supernode, z_k = (w_k - sum_q L(k, q) z_q) /
-// L(k, k); then every row i below gets w_i -= sum_k L(i, k) z_k. Backward,
-// L^T X = Z in reverse: the rows below (already solved) are subtracted from
-// the supernode's columns, then the triangle is solved from its last column.
-template <typename Scalar, int R>
-void SparseCholeskyFactor::SolveInPlace(const Scalar* values, int r,
-                                        double* w) const {
-  using Vector = Eigen::Matrix<double, R, 1>;
-  using Map = Eigen::Map<Vector>;
-  const int num_supernodes = static_cast<int>(rows_.size());
-  const Scalar* v = values;
-  const int* below = row_index_.data();
+namespace {
+
+// One supernode of the solves on W (r x N, column j = the r-vector w_j):
+// columns j0 .. j0 + c - 1, `nb` rows `below`, values as documented in the
+// header. C is c when fixed at compile time (then the supernode's r x c
+// block of W is held in registers across its rows), else Eigen::Dynamic.
+// Forward, L Z = W^T: z_k = (w_k - sum_q L(k, q) z_q) / L(k, k) within the
+// supernode, then w_i -= sum_k L(i, k) z_k for every row i below. Returns
+// the values after the supernode's. `scratch` holds r doubles (the row sums
+// of a dynamic R, so that no supernode allocates).
+template <typename Scalar, int R, int C>
+EIGEN_ALWAYS_INLINE const Scalar* ForwardSupernode(const Scalar* v,
+                                                   const int* below, int nb,
+                                                   int c, int r, int j0,
+                                                   double* w, double* scratch) {
+  using Map = Eigen::Map<Eigen::Matrix<double, R, 1>>;
   auto column = [&](int j) {
     return Map(w + static_cast<std::ptrdiff_t>(j) * r, r);
   };
-  Vector sum(r);
-  for (int s = 0; s < num_supernodes; ++s) {
-    const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
-    for (int k = 0; k < c; ++k) {
-      Map w_k = column(j0 + k);
-      for (int q = 0; q < k; ++q) {
-        w_k -= static_cast<double>(v[q]) * column(j0 + q);
-      }
-      w_k *= static_cast<double>(v[k]);
-      v += k + 1;
+  for (int k = 0; k < c; ++k) {
+    Map w_k = column(j0 + k);
+    for (int q = 0; q < k; ++q) {
+      w_k -= static_cast<double>(v[q]) * column(j0 + q);
     }
-    for (int i = 0; i < nb; ++i, v += c) {
-      sum = static_cast<double>(v[0]) * column(j0);
-      for (int k = 1; k < c; ++k) {
-        sum += static_cast<double>(v[k]) * column(j0 + k);
-      }
-      column(below[i]) -= sum;
-    }
-    below += nb;
+    w_k *= static_cast<double>(v[k]);
+    v += k + 1;
   }
-  for (int s = num_supernodes - 1; s >= 0; --s) {
-    const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
-    below -= nb;
-    v -= static_cast<std::ptrdiff_t>(nb) * c;
-    const Scalar* rectangle = v;
+  if constexpr (R != Eigen::Dynamic && C != Eigen::Dynamic) {
+    const Eigen::Matrix<double, R, C> Z =
+        Eigen::Map<const Eigen::Matrix<double, R, C>>(
+            w + static_cast<std::ptrdiff_t>(j0) * r);
+    // The same operations in the same order as the generic loop below
+    // (results must not depend on how the rows were split).
+    if constexpr (C == 1) {
+      for (int i = 0; i < nb; ++i) {
+        column(below[i]) -= static_cast<double>(v[i]) * Z.col(0);
+      }
+      v += nb;
+    } else {
+      for (int i = 0; i < nb; ++i, v += C) {
+        Eigen::Matrix<double, R, 1> sum = static_cast<double>(v[0]) * Z.col(0);
+        for (int k = 1; k < C; ++k) {
+          sum += static_cast<double>(v[k]) * Z.col(k);
+        }
+        column(below[i]) -= sum;
+      }
+    }
+  } else {
+    auto rows = [&](auto&& sum) {
+      for (int i = 0; i < nb; ++i, v += c) {
+        sum = static_cast<double>(v[0]) * column(j0);
+        for (int k = 1; k < c; ++k) {
+          sum += static_cast<double>(v[k]) * column(j0 + k);
+        }
+        column(below[i]) -= sum;
+      }
+    };
+    if constexpr (R == Eigen::Dynamic) {
+      rows(Map(scratch, r));
+    } else {
+      rows(Eigen::Matrix<double, R, 1>());
+    }
+  }
+  return v;
+}
+
+// Backward, L^T X = Z, for the supernode whose values start at `v`: the rows
+// below (already solved) are subtracted from its columns, then its triangle
+// is solved from its last column.
+template <typename Scalar, int R, int C>
+EIGEN_ALWAYS_INLINE void BackwardSupernode(const Scalar* v, const int* below,
+                                           int nb, int c, int r, int j0,
+                                           double* w) {
+  using Map = Eigen::Map<Eigen::Matrix<double, R, 1>>;
+  auto column = [&](int j) {
+    return Map(w + static_cast<std::ptrdiff_t>(j) * r, r);
+  };
+  const Scalar* rectangle = v + static_cast<std::ptrdiff_t>(c) * (c + 1) / 2;
+  if constexpr (R != Eigen::Dynamic && C != Eigen::Dynamic) {
+    Eigen::Map<Eigen::Matrix<double, R, C>> block(
+        w + static_cast<std::ptrdiff_t>(j0) * r);
+    Eigen::Matrix<double, R, C> sum = block;
+    for (int i = 0; i < nb; ++i, rectangle += C) {
+      const Map w_i = column(below[i]);
+      for (int k = 0; k < C; ++k) {
+        sum.col(k) -= static_cast<double>(rectangle[k]) * w_i;
+      }
+    }
+    block = sum;
+  } else {
     for (int i = 0; i < nb; ++i, rectangle += c) {
       const Map w_i = column(below[i]);
       for (int k = 0; k < c; ++k) {
         column(j0 + k) -= static_cast<double>(rectangle[k]) * w_i;
       }
     }
-    v -= static_cast<std::ptrdiff_t>(c) * (c + 1) / 2;
-    for (int k = c - 1; k >= 0; --k) {
-      const Scalar* row = v + static_cast<std::ptrdiff_t>(k) * (k + 1) / 2;
-      Map w_k = column(j0 + k);
-      w_k *= static_cast<double>(row[k]);
-      for (int q = 0; q < k; ++q) {
-        column(j0 + q) -= static_cast<double>(row[q]) * w_k;
+  }
+  for (int k = c - 1; k >= 0; --k) {
+    const Scalar* row = v + static_cast<std::ptrdiff_t>(k) * (k + 1) / 2;
+    Map w_k = column(j0 + k);
+    w_k *= static_cast<double>(row[k]);
+    for (int q = 0; q < k; ++q) {
+      column(j0 + q) -= static_cast<double>(row[q]) * w_k;
+    }
+  }
+}
+
+}  // namespace
+
+template <typename Scalar, int R>
+void SparseCholeskyFactor::SolveInPlace(const Scalar* values, int r,
+                                        double* w) const {
+  constexpr int kDynamic = Eigen::Dynamic;
+  const int num_supernodes = static_cast<int>(rows_.size());
+  const Scalar* v = values;
+  const int* below = row_index_.data();
+  using Vector = Eigen::Matrix<double, R, 1>;
+  using Map = Eigen::Map<Vector>;
+  auto column = [&](int j) {
+    return Map(w + static_cast<std::ptrdiff_t>(j) * r, r);
+  };
+  // Row sums of a dynamic R (fixed sizes live in registers).
+  Eigen::VectorXd scratch(R == kDynamic ? r : 0);
+  for (int s = 0; s < num_supernodes; ++s) {
+    const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
+    if (c == 1) {  // The common case of sparse factors, kept tight.
+      Map w_j = column(j0);
+      w_j *= static_cast<double>(v[0]);
+      for (int i = 0; i < nb; ++i) {
+        column(below[i]) -= static_cast<double>(v[1 + i]) * w_j;
       }
+      v += 1 + nb;
+      below += nb;
+      continue;
+    }
+    switch (R == kDynamic ? 0 : c) {
+      case 2:
+        v = ForwardSupernode<Scalar, R, 2>(v, below, nb, c, r, j0, w,
+                                           scratch.data());
+        break;
+      case 3:
+        v = ForwardSupernode<Scalar, R, 3>(v, below, nb, c, r, j0, w,
+                                           scratch.data());
+        break;
+      case 4:
+        v = ForwardSupernode<Scalar, R, 4>(v, below, nb, c, r, j0, w,
+                                           scratch.data());
+        break;
+      default:
+        v = ForwardSupernode<Scalar, R, kDynamic>(v, below, nb, c, r, j0, w,
+                                                  scratch.data());
+    }
+    below += nb;
+  }
+  for (int s = num_supernodes - 1; s >= 0; --s) {
+    const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
+    below -= nb;
+    v -= static_cast<std::ptrdiff_t>(nb) * c +
+         static_cast<std::ptrdiff_t>(c) * (c + 1) / 2;
+    if (c == 1) {
+      Map w_j = column(j0);
+      auto solve = [&](auto&& sum) {
+        sum = w_j;
+        for (int i = 0; i < nb; ++i) {
+          sum -= static_cast<double>(v[1 + i]) * column(below[i]);
+        }
+        w_j = sum * static_cast<double>(v[0]);
+      };
+      if constexpr (R == kDynamic) {
+        solve(Map(scratch.data(), r));
+      } else {
+        solve(Vector());
+      }
+      continue;
+    }
+    switch (R == kDynamic ? 0 : c) {
+      case 2:
+        BackwardSupernode<Scalar, R, 2>(v, below, nb, c, r, j0, w);
+        break;
+      case 3:
+        BackwardSupernode<Scalar, R, 3>(v, below, nb, c, r, j0, w);
+        break;
+      case 4:
+        BackwardSupernode<Scalar, R, 4>(v, below, nb, c, r, j0, w);
+        break;
+      default:
+        BackwardSupernode<Scalar, R, kDynamic>(v, below, nb, c, r, j0, w);
     }
   }
 }
