@@ -13,6 +13,8 @@
 #include "ceres_sesync/ceres_baseline.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/internal/chi_square.h"
+#include "ceres_sesync/internal/staircase.h"
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/outlier_generator.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "gmock/gmock.h"
@@ -285,6 +287,32 @@ TEST(RobustSolver, InvalidOptionsAndInputsAreReported) {
   SolveRobust(bad, Options(), &s);
   EXPECT_EQ(s.status, RobustSolverSummary::Status::kInvalidInput);
   EXPECT_THAT(s.BriefReport(), ::testing::HasSubstr("INVALID_INPUT"));
+}
+
+// Weights apply to pose-pose measurements only; graphs with landmarks or
+// priors are refused with a message (not solved with unweighted landmark
+// terms silently), by SolveRobust and by the weighted Staircase.
+TEST(RobustSolver, LandmarksAndPriorsAreRefusedClearly) {
+  LandmarkGraphOptions generator;
+  generator.num_poses = 30;
+  generator.num_landmarks = 20;
+  generator.start_prior = true;
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(GenerateLandmarkGraph(generator, &graph, nullptr, &error))
+      << error;
+  RobustSolverSummary s;
+  EXPECT_TRUE(SolveRobust(graph, Options(), &s).empty());
+  EXPECT_EQ(s.status, RobustSolverSummary::Status::kInvalidInput);
+  EXPECT_THAT(s.message, ::testing::HasSubstr("landmarks or priors"));
+
+  SolverSummary summary;
+  internal::Staircase staircase(
+      graph, SolverOptions(), &summary, internal::Staircase::Clock::now(),
+      internal::MeasurementWeights(graph.measurements.size(), 1.0));
+  EXPECT_FALSE(staircase.ok());
+  EXPECT_EQ(summary.status, SolverSummary::Status::kInvalidInput);
+  EXPECT_THAT(summary.message, ::testing::HasSubstr("landmarks or priors"));
 }
 
 // Ceres with Huber and Cauchy losses on the same terms: the robust
