@@ -27,7 +27,7 @@ fi
 "$root/scripts/install-deps.sh"
 build=${BUILD_DIR:-$root/build}
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j"$(nproc)" --target bench cube_sweep scaling -- \
+cmake --build "$build" -j"$(nproc)" --target bench cube_sweep scaling landmarks -- \
   --no-print-directory >/dev/null
 bin=$build/bench
 py=/usr/bin/python3  # Debian's, with python3-matplotlib.
@@ -48,6 +48,7 @@ if [ $quick -eq 1 ]; then
   "$bin/cube_sweep" --quick --out_dir "$out" >"$out/cube_sweep.txt"
   "$py" "$root/bench/plot_cube_sweep.py" "$out"
   "$bin/scaling" --quick --out_dir "$out" >"$out/scaling.txt"
+  "$bin/landmarks" --quick --out_dir "$out" >"$out/landmarks.txt"
   "$py" "$root/bench/plot_scaling.py" "$out"
   echo "bench.sh --quick: outputs in $out ($(($(date +%s) - start)) s)"
   exit 0
@@ -85,7 +86,11 @@ done
 #    SE-Sync vs Ceres PDL-GN/LM from chordal, one process per run.
 "$bin/scaling" --ceres_max_time 600 --out_dir "$out" | tee "$out/scaling.txt"
 
-# 5) Plots.
+# 5) Landmark SLAM and priors (issue #15): generated 2D/3D maps, SE-Sync vs
+#    Ceres from odometry and chordal, every result certified (a few minutes).
+"$bin/landmarks" --out_dir "$out" | tee "$out/landmarks.txt"
+
+# 6) Plots.
 "$py" "$root/bench/plot_cube_sweep.py" "$out"
 "$py" "$root/bench/plot_scaling.py" "$out"
 "$py" "$root/bench/plot_trajectory.py" "$poses" "$out" --compare manhattan
