@@ -101,14 +101,28 @@ bool Certify(const PoseGraph& graph, const Solution& candidate_solution,
     const double trace = internal::BlockDiagonalTrace(Lambda, d);
     c.rotation_objective = trace;
     // Largest eta for which the bound can still meet a relative bound b:
-    // objective - (trace - eta d n) <= b (trace - eta d n).
+    // objective - (trace - eta d n) <= b (trace - eta d n), with the
+    // objective rounded up as in the reported bound below, and b lowered by
+    // a relative 1e-6 for the proof's own slack (the proven shift is c plus
+    // its backward error; the lower bound is rounded down): a proof at
+    // eta_max then certifies instead of landing just above the tolerance.
+    const double objective_up =
+        internal::ObjectiveUpperBound(graph, projected, landmarks);
     auto eta_for = [&](double b) {
-      return (b * trace - (c.objective - trace)) / (d * n_rot * (1 + b));
+      b *= 1 - 1e-6;
+      return (b * trace - (objective_up - trace)) / (d * n_rot * (1 + b));
     };
     internal::VerificationOptions verification;
     verification.eta_max =
         std::max(eta_for(options.max_relative_suboptimality), 0.0);
-    verification.eta_goal = eta_for(options.goal_relative_suboptimality);
+    // The goal: goal_relative_suboptimality, or when the candidate's own
+    // excess over tr(Lambda) (its translations and landmarks not optimal
+    // for its rotations, e.g. a local solver stopped early) already exceeds
+    // it, four times that excess: a bound the proof can still reach.
+    const double excess = (objective_up - trace) / std::abs(trace);
+    verification.eta_goal = eta_for(
+        std::min(std::max(options.goal_relative_suboptimality, 4 * excess),
+                 options.max_relative_suboptimality));
     verification.eta_target =
         std::max(options.target_relative_bound * std::abs(trace) / (d * n_rot),
                  std::numeric_limits<double>::min());

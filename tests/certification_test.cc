@@ -7,7 +7,9 @@
 #include <random>
 
 #include "ceres_sesync/ceres_baseline.h"
+#include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/cube_generator.h"
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "gtest/gtest.h"
 
@@ -95,6 +97,70 @@ TEST(CertificationTest, PerturbedOptimumIsNotCertified) {
     ASSERT_EQ(certificate.negative_curvature_direction.size(),
               d * graph.num_poses);
     EXPECT_LT(certificate.negative_curvature, 0);
+  }
+}
+
+// Near-optimal candidates, like a local solver's answer stopped by its
+// function tolerance: the optimum with every rotation turned by N(0, s) rad
+// (2D) and its own translations and landmarks. F(candidate) - F* is then a
+// small relative excess e, and S(candidate) has lambda_min ~ -e tr(Lambda) /
+// dn. The bound must stay sound (lower bound <= F*), certify whenever e is
+// well inside the tolerance, and be tight (<= 2e + 1e-6), also when
+// lambda_min(S) is below the goal shift, where the proof used to jump to
+// the tolerance itself and land just above it (not certified at e ~ 1e-6).
+TEST(CertificationTest, NearOptimalCandidatesCertifyWithTightBounds) {
+  PoseGraph city, map;
+  Poses city_optimum;
+  Solution map_optimum;
+  SolverSummary city_summary, map_summary;
+  std::string error;
+  CityOptions city_options;
+  city_options.num_poses = 1000;
+  city_options.seed = 1;
+  ASSERT_TRUE(GenerateCity(city_options, &city, nullptr, &error)) << error;
+  city_optimum = Solve(city, SolverOptions(), &city_summary);
+  ASSERT_TRUE(city_summary.certified()) << city_summary.FullReport();
+  LandmarkGraphOptions map_options;
+  map_options.num_poses = 300;
+  map_options.num_landmarks = 400;
+  map_options.seed = 1;
+  ASSERT_TRUE(GenerateLandmarkGraph(map_options, &map, nullptr, &error))
+      << error;
+  Solve(map, SolverOptions(), &map_optimum, &map_summary);
+  ASSERT_TRUE(map_summary.certified()) << map_summary.FullReport();
+
+  struct Case {
+    const PoseGraph* graph;
+    Solution optimum;
+    double f_star;
+  };
+  for (const Case& c :
+       {Case{&city, Solution{city_optimum, {}}, city_summary.objective},
+        Case{&map, map_optimum, map_summary.objective}}) {
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> normal;
+    for (double s : {1e-5, 3e-5, 1e-4, 2e-4, 3e-4}) {
+      Solution candidate = c.optimum;
+      for (Pose& p : candidate.poses) {
+        const double a = s * normal(rng);
+        Eigen::Matrix2d turn;
+        turn << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+        p.R = p.R * turn;
+      }
+      Certificate certificate;
+      ASSERT_TRUE(Certify(*c.graph, candidate, {}, &certificate, &error))
+          << error;
+      const double excess = (certificate.objective - c.f_star) / c.f_star;
+      SCOPED_TRACE("n = " + std::to_string(c.graph->num_poses) + ", s = " +
+                   std::to_string(s) + ", excess " + std::to_string(excess));
+      ASSERT_GT(excess, 0);
+      ASSERT_LT(excess, 1e-4);
+      EXPECT_LE(certificate.lower_bound, c.f_star * (1 + 1e-12));
+      EXPECT_TRUE(certificate.certified) << certificate.FullReport();
+      EXPECT_LE(certificate.relative_suboptimality_bound, 2 * excess + 1e-6)
+          << certificate.FullReport();
+      EXPECT_GE(certificate.relative_suboptimality_bound, 0.9 * excess);
+    }
   }
 }
 

@@ -176,17 +176,52 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     }
     return true;
   };
-  // Double-double proofs at shifts from the goal down to the tolerance; the
-  // first success ends them (each costs 1-3.4 double factorizations, measured).
-  auto prove_extended = [&]() {
-    double tried = 0;
-    for (double c : {goal / 16, goal, eta_max}) {
-      c = std::max(c, eta_target);
-      if (c >= result.eta) break;  // Could not improve on what is proven.
-      if (c <= tried) continue;
-      tried = c;
-      if (prove(c, ProofPrecision::kDoubleDouble)) break;
+  // lambda_min(S) estimated by shift-and-invert Lanczos on the current
+  // double factor, which must be that of S + shift I (Factorize()); NaN if
+  // Lanczos does not converge.
+  auto estimate_lambda_min = [&](double shift) {
+    ShiftInvertOperator op(matrix);
+    const int dim = matrix->dimension();
+    Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1, std::min(20, dim));
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-8);
+    if (eigs.info() != Spectra::CompInfo::Successful) {
+      return std::numeric_limits<double>::quiet_NaN();
     }
+    return 1.0 / eigs.eigenvalues()(0) - shift;
+  };
+  // Double-double proofs from the goal up to the tolerance; the first
+  // success ends them (each costs 1-3.4 double factorizations, measured).
+  // When the goal fails (lambda_min(S) < -goal), the next shifts come from
+  // an estimate of lambda_min(S) if the double factor at eta_max is at hand
+  // (`factor_at_eta_max`), else by factors of 8, so that the proven bound
+  // lands near what lambda_min(S) allows instead of at the tolerance itself
+  // (where the rounded-up objective can put it just outside).
+  auto prove_extended = [&](bool factor_at_eta_max) {
+    double tried = 0;
+    // True when done: proven, or c cannot improve on what is proven.
+    auto attempt = [&](double c) {
+      c = std::max(c, eta_target);
+      if (c >= result.eta) return true;
+      if (c <= tried) return false;
+      tried = c;
+      return prove(c, ProofPrecision::kDoubleDouble);
+    };
+    if (attempt(goal / 16) || attempt(goal)) return;
+    if (factor_at_eta_max) {
+      const double lambda_min = estimate_lambda_min(eta_max);
+      if (std::isfinite(lambda_min)) {
+        result.lambda_min_estimate = lambda_min;
+        if (-lambda_min < eta_max &&
+            (attempt(-1.1 * lambda_min) || attempt(-2 * lambda_min))) {
+          return;
+        }
+      }
+    }
+    for (double c = 8 * std::max(tried, goal); c < eta_max; c *= 8) {
+      if (attempt(c)) return;
+    }
+    attempt(eta_max);
   };
 
   // 1. The fast path: a proof at the target shift, then in double one at a
@@ -212,15 +247,17 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // 2. Near-optimal (lambda_min(S) > -eta_max up to round-off) or not?
   bool near_optimal = result.eta <= eta_max;
   if (result.out_of_time) return finish();
+  // The double factor is that of S + eta_max I (no proof since).
+  bool factor_at_eta_max = false;
   if (!near_optimal && eta_max > eta_target &&
       fits(matrix->PredictedSeconds(ProofPrecision::kDouble))) {
-    near_optimal = matrix->Factorize(Lambda, eta_max);
+    near_optimal = factor_at_eta_max = matrix->Factorize(Lambda, eta_max);
   }
   if (result.out_of_time) return finish();
   // 3. Near-optimal: tighten the proof.
   if (near_optimal) {
     if (use_extended) {
-      prove_extended();
+      prove_extended(factor_at_eta_max);
     } else {
       // Double only: the strict proofs need shifts above what the
       // translation shift mu costs and above those that failed already;
@@ -229,15 +266,9 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       double start =
           std::max({eta_target, 1.5 * double_floor, 2 * failed_double,
                     std::numeric_limits<double>::min()});
-      if (result.eta > eta_max) {  // The current factor is that at eta_max.
-        ShiftInvertOperator op(matrix);
-        const int dim = matrix->dimension();
-        Spectra::SymEigsSolver<ShiftInvertOperator> eigs(op, 1,
-                                                         std::min(20, dim));
-        eigs.init();
-        eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-8);
-        if (eigs.info() == Spectra::CompInfo::Successful) {
-          result.lambda_min_estimate = 1.0 / eigs.eigenvalues()(0) - eta_max;
+      if (factor_at_eta_max) {
+        result.lambda_min_estimate = estimate_lambda_min(eta_max);
+        if (std::isfinite(result.lambda_min_estimate)) {
           start = std::max(start, -1.1 * result.lambda_min_estimate);
         }
       }
@@ -335,7 +366,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // round-off (large maps: mu's cost); prove it in double-double.
   if (use_extended && result.eta > eta_max &&
       !(result.direction_curvature < -eta_max)) {
-    prove_extended();
+    prove_extended(false);
   }
   return finish();
 }

@@ -88,9 +88,10 @@ Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
 //  2. one factorization (no proof) at eta_max tells a near-optimal Lambda
 //     (it succeeds: lambda_min(S) > -eta_max up to double round-off) from a
 //     saddle or poor candidate;
-//  3. near-optimal: proofs at eta_goal / 16, eta_goal, eta_max, in
-//     double-double unless the policy is kDouble (then double, at shifts
-//     guided by a shift-and-invert Lanczos estimate);
+//  3. near-optimal: proofs at eta_goal / 16 and eta_goal, then (when they
+//     fail) at shifts guided by a shift-and-invert Lanczos estimate of
+//     lambda_min(S) from the factor at eta_max, then by factors of 8 up to
+//     eta_max, in double-double unless the policy is kDouble (then double);
 //  4. otherwise: a witness of negative curvature (for the staircase's escape
 //     and Certify's report) from Lanczos on S or, where that does not
 //     converge, shift-and-invert Lanczos on the first proven shift of a

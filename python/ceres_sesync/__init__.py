@@ -6,7 +6,9 @@
     r = cs.solve(g)                        # keywords: SolverOptions fields
     print(r.status, r.objective, r.lower_bound, r.relative_suboptimality_bound)
     r.rotations, r.translations            # (n, d, d) and (n, d), graph pose order
+    r.landmarks                            # (L, d) landmark positions (L may be 0)
     c = cs.certify(g, rotations, translations)   # any solution, e.g. from Ceres
+    c = cs.certify(g, rotations, translations, landmarks)   # with landmarks
     cs.write_g2o("out.g2o", g, r.rotations, r.translations)
 
 The C++ headers (ceres_sesync/*.h) document every option and summary field;
@@ -29,6 +31,7 @@ from ._ceres_sesync import (
     G2oReadOptions,
     G2oReadSummary,
     Initialization,
+    LandmarkGraphOptions,
     LocalSolver,
     Measurements,
     PoseGraph,
@@ -53,6 +56,7 @@ __all__ = [
     "G2oReadOptions",
     "G2oReadSummary",
     "Initialization",
+    "LandmarkGraphOptions",
     "LocalSolver",
     "Measurements",
     "PoseGraph",
@@ -67,8 +71,10 @@ __all__ = [
     "evaluate_objective",
     "generate_city",
     "generate_cube",
+    "generate_landmarks",
     "read_g2o",
     "read_g2o_poses",
+    "read_g2o_solution",
     "solve",
     "solve_components",
     "write_g2o",
@@ -124,16 +130,27 @@ def read_g2o_poses(path, graph):
     return _core._read_g2o_poses(_input_path(path), graph)
 
 
-def write_g2o(path, graph, rotations=None, translations=None):
+def read_g2o_solution(path, graph):
+    """As read_g2o_poses(), and also the landmark VERTEX lines (VERTEX_XY /
+    VERTEX_TRACKXYZ), matched by id to the landmarks of `graph`.
+
+    Returns (rotations (n, d, d), translations (n, d), landmarks (L, d)).
+    """
+    return _core._read_g2o_solution(_input_path(path), graph)
+
+
+def write_g2o(path, graph, rotations=None, translations=None, landmarks=None):
     """Writes the whole graph (edges with isotropic information reproducing
-    kappa and tau, FIX) as g2o, with VERTEX lines for the given poses if any.
+    kappa and tau, landmark measurements, priors, FIX) as g2o, with VERTEX
+    lines for the given poses and landmark positions ((L, d)) if any.
     Atomic: on failure (OSError) no partial file is left."""
-    _core._write_g2o(_os.fspath(path), graph, rotations, translations)
+    _core._write_g2o(_os.fspath(path), graph, rotations, translations, landmarks)
 
 
-def write_g2o_poses(path, graph, rotations, translations):
-    """Writes only VERTEX lines (original ids) for the poses. Atomic."""
-    _core._write_g2o_poses(_os.fspath(path), graph, rotations, translations)
+def write_g2o_poses(path, graph, rotations, translations, landmarks=None):
+    """Writes only VERTEX lines (original ids) for the poses, and for the
+    landmark positions ((L, d)) if given. Atomic."""
+    _core._write_g2o_poses(_os.fspath(path), graph, rotations, translations, landmarks)
 
 
 def write_tum(path, graph, rotations, translations):
@@ -204,9 +221,11 @@ Measurements.__repr__ = lambda s: f"<Measurements: {len(s)} measurements>"
 PoseGraphComponent.__repr__ = lambda c: f"<PoseGraphComponent: {c.graph!r}>"
 
 
-def evaluate_objective(graph, rotations, translations):
-    """F(x) of eq. (12) at the given poses ((n, d, d) and (n, d) arrays)."""
-    return _core._evaluate_objective(graph, rotations, translations)
+def evaluate_objective(graph, rotations, translations, landmarks=None):
+    """F(x) of eq. (12) at the given poses ((n, d, d) and (n, d) arrays), plus
+    the landmark and prior terms (landmarks: (L, d), required when the graph
+    has landmarks)."""
+    return _core._evaluate_objective(graph, rotations, translations, landmarks)
 
 
 def generate_cube(**options):
@@ -231,6 +250,26 @@ def generate_city(**options):
     return _core._generate_city(_options(CityOptions, options, "generate_city"))
 
 
+def generate_landmarks(preset="manhattan", **options):
+    """A landmark-SLAM graph: a Manhattan walk observing random point
+    landmarks within a sensor range, optional GPS-like position priors
+    (gps_interval) and a start prior (see ceres_sesync/landmark_generator.h).
+
+    preset="victoria" starts from the Victoria-Park-like dense preset (2000
+    poses, ~30 landmarks per pose); keyword options are LandmarkGraphOptions
+    fields and override the preset's. Returns (graph, true_rotations,
+    true_translations, true_landmarks).
+    """
+    if preset == "victoria":
+        base = _core._victoria_park_like_options()
+    elif preset == "manhattan":
+        base = LandmarkGraphOptions()
+    else:
+        raise ValueError(f"preset '{preset}' is not one of 'manhattan', 'victoria'")
+    _core._apply_keywords(base, options, "generate_landmarks")
+    return _core._generate_landmarks(base)
+
+
 # ---- solving and certifying --------------------------------------------------
 
 
@@ -246,7 +285,9 @@ def solve(graph, initial_rotations=None, **options):
 
     Returns a SolveResult: every SolverSummary field (status, objective,
     lower_bound, relative_suboptimality_bound, levels, times, ...), certified,
-    rotations (n, d, d), translations (n, d), and summary (the full report).
+    rotations (n, d, d), translations (n, d), landmarks (L, d: the landmark
+    positions, L = 0 without landmarks), and summary (the full report). With
+    priors the solution is in their world frame.
     """
     options = _options(SolverOptions, options, "solve")
     return _core._solve(graph, options, initial_rotations)
@@ -265,8 +306,9 @@ def solve_components(graph, **options):
     return _core._solve_by_component(graph, options)
 
 
-def certify(graph, rotations, translations, **options):
-    """Certifies any solution (rotations (n, d, d), translations (n, d)).
+def certify(graph, rotations, translations, landmarks=None, **options):
+    """Certifies any solution (rotations (n, d, d), translations (n, d), and
+    landmarks (L, d) when the graph has landmarks).
 
     Keyword options are CertifyOptions fields, e.g.
     max_relative_suboptimality=1e-3, improve_if_not_certified=False,
@@ -274,12 +316,12 @@ def certify(graph, rotations, translations, **options):
     objective, lower_bound (a proven lower bound on the optimum, valid whether
     or not certified), relative_suboptimality_bound,
     negative_curvature_direction (None or a witness of non-optimality),
-    improved_poses, ... and summary (the full report).
+    improved_poses, improved_landmarks, ... and summary (the full report).
 
     Raises ValueError for arrays of the wrong shape or non-finite values.
     """
     options = _options(CertifyOptions, options, "certify")
-    return _core._certify(graph, rotations, translations, options)
+    return _core._certify(graph, rotations, translations, landmarks, options)
 
 
 # ---- generic helpers on every bound struct -------------------------------------
@@ -315,6 +357,7 @@ for _cls in (
     CubeOptions,
     G2oReadOptions,
     G2oReadSummary,
+    LandmarkGraphOptions,
     SolveResult,
     SolverOptions,
     SolverProgress,
@@ -327,6 +370,7 @@ for _cls in (
     CityOptions,
     CubeOptions,
     G2oReadOptions,
+    LandmarkGraphOptions,
     SolverOptions,
     SolverProgress,
 ):

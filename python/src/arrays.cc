@@ -112,6 +112,40 @@ Poses ToPoses(const PoseGraph& graph, py::handle rotations,
   return poses;
 }
 
+LandmarkPositions ToLandmarks(const PoseGraph& graph, py::handle landmarks,
+                              bool require_finite) {
+  const int d = graph.dimension;
+  const py::ssize_t L = graph.num_landmarks;
+  if (landmarks.is_none()) {
+    if (L == 0) return {};
+    throw py::value_error("landmarks: the graph has " + std::to_string(L) +
+                          " landmarks; pass their positions, shape (" +
+                          std::to_string(L) + ", " + std::to_string(d) + ")");
+  }
+  const DoubleArray p = ToDoubleArray(landmarks, "landmarks", {L, d});
+  if (require_finite &&
+      !std::all_of(p.data(), p.data() + p.size(),
+                   [](double v) { return std::isfinite(v); })) {
+    throw py::value_error("landmarks: not finite (NaN or Inf)");
+  }
+  auto q = p.unchecked<2>();
+  LandmarkPositions out(L, Eigen::VectorXd(d));
+  for (py::ssize_t k = 0; k < L; ++k) {
+    for (int a = 0; a < d; ++a) out[k](a) = q(k, a);
+  }
+  return out;
+}
+
+DoubleArray LandmarksArray(const LandmarkPositions& landmarks, int d) {
+  const py::ssize_t L = static_cast<py::ssize_t>(landmarks.size());
+  DoubleArray out({L, static_cast<py::ssize_t>(d)});
+  auto q = out.mutable_unchecked<2>();
+  for (py::ssize_t k = 0; k < L; ++k) {
+    for (int a = 0; a < d; ++a) q(k, a) = landmarks[k](a);
+  }
+  return out;
+}
+
 DoubleArray RotationsArray(const Poses& poses, int d) {
   const py::ssize_t n = static_cast<py::ssize_t>(poses.size());
   DoubleArray out(

@@ -36,6 +36,13 @@ py::array_t<int64_t, py::array::c_style> ToIndexArray(py::handle value,
 Poses ToPoses(const PoseGraph& graph, py::handle rotations,
               py::handle translations, bool require_finite = false);
 
+// Landmark positions from an (L, d) array (L and d from `graph`; None is
+// accepted for a graph without landmarks).
+LandmarkPositions ToLandmarks(const PoseGraph& graph, py::handle landmarks,
+                              bool require_finite = false);
+// (L, d) landmark positions as a new array.
+DoubleArray LandmarksArray(const LandmarkPositions& landmarks, int d);
+
 // The rotations / translations of `poses` as new arrays.
 DoubleArray RotationsArray(const Poses& poses, int d);
 DoubleArray TranslationsArray(const Poses& poses, int d);

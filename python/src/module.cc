@@ -23,6 +23,7 @@
 #include "ceres_sesync/component_solver.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/pose_graph.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "glog/logging.h"
@@ -37,7 +38,7 @@ using Status = SolverSummary::Status;
 // ---- results: the C++ summaries plus the numpy arrays of the poses --------
 
 struct SolveResult : SolverSummary {
-  py::object rotations, translations;
+  py::object rotations, translations, landmarks;
 };
 
 struct ComponentsResult : ComponentsSummary {
@@ -231,6 +232,9 @@ void BindSolverSummary(py::module_& m) {
       .ro("dimension", &S::dimension)
       .ro("num_poses", &S::num_poses)
       .ro("num_measurements", &S::num_measurements)
+      .ro("num_landmarks", &S::num_landmarks)
+      .ro("num_landmark_measurements", &S::num_landmark_measurements)
+      .ro("num_priors", &S::num_priors)
       .ro("objective", &S::objective)
       .ro("sdp_value", &S::sdp_value)
       .ro("lower_bound", &S::lower_bound)
@@ -266,7 +270,9 @@ void BindSolverSummary(py::module_& m) {
       .ro("rotations", &SolveResult::rotations,
           "(n, d, d) rotations, in the graph's pose order")
       .ro("translations", &SolveResult::translations,
-          "(n, d) translations, in the graph's pose order");
+          "(n, d) translations, in the graph's pose order")
+      .ro("landmarks", &SolveResult::landmarks,
+          "(L, d) landmark positions, in the graph's landmark order");
   result.def_property_readonly("summary", &S::FullReport);
 }
 
@@ -322,6 +328,14 @@ void BindCertificate(py::module_& m) {
                               c.improvement_summary.dimension);
           },
           "(rotations, translations) of the improvement run, or None")
+      .get(
+          "improved_landmarks",
+          [](const C& c) -> py::object {
+            if (!c.has_improved_poses) return py::none();
+            return LandmarksArray(c.improved_landmarks,
+                                  c.improvement_summary.dimension);
+          },
+          "(L, d) landmark positions of the improvement run, or None")
       .ro("improvement_summary", &C::improvement_summary)
       .ro("time_s", &C::time_s);
   cls.def_property_readonly("brief_report", &C::BriefReport)
@@ -711,20 +725,41 @@ void BindIo(py::module_& m) {
     if (!ReadG2oPoses(path, graph, &poses, &error)) InputError(error);
     return PosesTuple(poses, graph.dimension);
   });
+  m.def("_read_g2o_solution",
+        [](const std::string& path, const PoseGraph& graph) {
+          Solution solution;
+          std::string error;
+          if (!ReadG2oSolution(path, graph, &solution, &error))
+            InputError(error);
+          const int d = graph.dimension;
+          return py::make_tuple(RotationsArray(solution.poses, d),
+                                TranslationsArray(solution.poses, d),
+                                LandmarksArray(solution.landmarks, d));
+        });
   m.def("_write_g2o", [](const std::string& path, const PoseGraph& graph,
-                         py::handle rotations, py::handle translations) {
+                         py::handle rotations, py::handle translations,
+                         py::handle landmarks) {
     Poses poses;
     if (!rotations.is_none() || !translations.is_none()) {
       poses = ToPoses(graph, rotations, translations, true);
     }
+    LandmarkPositions positions;
+    if (!landmarks.is_none()) positions = ToLandmarks(graph, landmarks, true);
     std::string error;
-    WriteOrRaise(WriteG2oFile(path, graph, poses, &error), error);
+    WriteOrRaise(WriteG2oFile(path, graph, poses, positions, &error), error);
   });
   m.def("_write_g2o_poses", [](const std::string& path, const PoseGraph& graph,
-                               py::handle rotations, py::handle translations) {
-    const Poses poses = ToPoses(graph, rotations, translations, true);
+                               py::handle rotations, py::handle translations,
+                               py::handle landmarks) {
+    Solution solution{ToPoses(graph, rotations, translations, true), {}};
+    if (!landmarks.is_none()) {
+      solution.landmarks = ToLandmarks(graph, landmarks, true);
+    }
     std::string error;
-    WriteOrRaise(WriteG2oPoses(path, graph, poses, &error), error);
+    WriteOrRaise(landmarks.is_none()
+                     ? WriteG2oPoses(path, graph, solution.poses, &error)
+                     : WriteG2oSolution(path, graph, solution, &error),
+                 error);
   });
   m.def("_write_tum", [](const std::string& path, const PoseGraph& graph,
                          py::handle rotations, py::handle translations) {
@@ -732,10 +767,12 @@ void BindIo(py::module_& m) {
     std::string error;
     WriteOrRaise(WriteTumFile(path, graph, poses, &error), error);
   });
-  m.def("_evaluate_objective", [](const PoseGraph& graph, py::handle rotations,
-                                  py::handle translations) {
-    return EvaluateObjective(graph, ToPoses(graph, rotations, translations));
-  });
+  m.def(
+      "_evaluate_objective", [](const PoseGraph& graph, py::handle rotations,
+                                py::handle translations, py::handle landmarks) {
+        return EvaluateObjective(graph, ToPoses(graph, rotations, translations),
+                                 ToLandmarks(graph, landmarks));
+      });
 }
 
 void BindCube(py::module_& m) {
@@ -761,7 +798,9 @@ void BindCube(py::module_& m) {
     return py::make_tuple(std::move(graph), RotationsArray(truth, d),
                           TranslationsArray(truth, d));
   });
-  m.def("_expected_ground_truth_objective", &ExpectedGroundTruthObjective);
+  m.def(
+      "_expected_ground_truth_objective",
+      static_cast<double (*)(int, int, double)>(&ExpectedGroundTruthObjective));
 
   using CO = CityOptions;
   py::class_<CO> city(m, "CityOptions",
@@ -795,6 +834,55 @@ void BindCube(py::module_& m) {
   });
 }
 
+void BindLandmarkGenerator(py::module_& m) {
+  using O = LandmarkGraphOptions;
+  py::class_<O> cls(
+      m, "LandmarkGraphOptions",
+      "ceres_sesync::LandmarkGraphOptions (landmark_generator.h).");
+  Fields(cls)
+      .rw("dimension", &O::dimension)
+      .rw("num_poses", &O::num_poses)
+      .rw("step_length", &O::step_length)
+      .rw("block_length", &O::block_length)
+      .rw("turn_probability", &O::turn_probability)
+      .rw("world_size", &O::world_size)
+      .rw("num_landmarks", &O::num_landmarks)
+      .rw("sensor_range", &O::sensor_range)
+      .rw("detection_probability", &O::detection_probability)
+      .rw("max_observations_per_pose", &O::max_observations_per_pose)
+      .rw("kappa", &O::kappa)
+      .rw("tau", &O::tau)
+      .rw("landmark_nu", &O::landmark_nu)
+      .rw("gps_interval", &O::gps_interval)
+      .rw("gps_tau", &O::gps_tau)
+      .rw("start_prior", &O::start_prior)
+      .rw("start_prior_kappa", &O::start_prior_kappa)
+      .rw("start_prior_tau", &O::start_prior_tau)
+      .rw("noiseless", &O::noiseless)
+      .rw("seed", &O::seed);
+  KeywordInit<O>(cls, "LandmarkGraphOptions");
+  m.def("_victoria_park_like_options",
+        [] { return VictoriaParkLikeOptions(); });
+  m.def(
+      "_expected_landmark_graph_objective",
+      static_cast<double (*)(const PoseGraph&)>(&ExpectedGroundTruthObjective));
+  m.def("_generate_landmarks", [](const O& options) {
+    PoseGraph graph;
+    Solution truth;
+    std::string error;
+    bool ok;
+    {
+      py::gil_scoped_release release;
+      ok = GenerateLandmarkGraph(options, &graph, &truth, &error);
+    }
+    if (!ok) InputError(error);
+    const int d = graph.dimension;
+    return py::make_tuple(std::move(graph), RotationsArray(truth.poses, d),
+                          TranslationsArray(truth.poses, d),
+                          LandmarksArray(truth.landmarks, d));
+  });
+}
+
 void BindSolvers(py::module_& m) {
   m.def("_solve", [](const PoseGraph& graph, SolverOptions options,
                      py::object initial_rotations) {
@@ -808,15 +896,19 @@ void BindSolvers(py::module_& m) {
     }
     MakeInterruptible(&options);
     SolveResult result;
-    Poses poses;
+    Solution solution;
     {
       py::gil_scoped_release release;
-      poses = has_initial ? Solve(graph, initial, options, &result)
-                          : Solve(graph, options, &result);
+      if (has_initial) {
+        Solve(graph, initial, options, &solution, &result);
+      } else {
+        Solve(graph, options, &solution, &result);
+      }
     }
     if (result.status == Status::kInvalidInput) InputError(result.message);
-    result.rotations = RotationsArray(poses, graph.dimension);
-    result.translations = TranslationsArray(poses, graph.dimension);
+    result.rotations = RotationsArray(solution.poses, graph.dimension);
+    result.translations = TranslationsArray(solution.poses, graph.dimension);
+    result.landmarks = LandmarksArray(solution.landmarks, graph.dimension);
     return result;
   });
   m.def("_solve_by_component",
@@ -835,8 +927,10 @@ void BindSolvers(py::module_& m) {
           return result;
         });
   m.def("_certify", [](const PoseGraph& graph, py::handle rotations,
-                       py::handle translations, CertifyOptions options) {
-    const Poses candidate = ToPoses(graph, rotations, translations);
+                       py::handle translations, py::handle landmarks,
+                       CertifyOptions options) {
+    const Solution candidate{ToPoses(graph, rotations, translations),
+                             ToLandmarks(graph, landmarks)};
     MakeInterruptible(&options.solver_options);
     Certificate certificate;
     std::string error;
@@ -882,5 +976,6 @@ PYBIND11_MODULE(_ceres_sesync, m) {
   BindPoseGraph(m);
   BindIo(m);
   BindCube(m);
+  BindLandmarkGenerator(m);
   BindSolvers(m);
 }

@@ -24,6 +24,7 @@ STRUCTS = [
     ("component_solver.h", "PoseGraphComponent", cs.PoseGraphComponent),
     ("cube_generator.h", "CubeOptions", cs.CubeOptions),
     ("city_generator.h", "CityOptions", cs.CityOptions),
+    ("landmark_generator.h", "LandmarkGraphOptions", cs.LandmarkGraphOptions),
     ("g2o_io.h", "G2oReadOptions", cs.G2oReadOptions),
     ("g2o_io.h", "G2oReadSummary", cs.G2oReadSummary),
     ("pose_graph.h", "PoseGraph", cs.PoseGraph),
