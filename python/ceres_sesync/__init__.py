@@ -38,6 +38,9 @@ from ._ceres_sesync import (
     PoseGraphComponent,
     Preconditioner,
     ProofArithmetic,
+    RobustResult,
+    RobustSolverOptions,
+    RobustSolverSummary,
     SolveResult,
     SolverOptions,
     SolverProgress,
@@ -63,6 +66,9 @@ __all__ = [
     "PoseGraphComponent",
     "Preconditioner",
     "ProofArithmetic",
+    "RobustResult",
+    "RobustSolverOptions",
+    "RobustSolverSummary",
     "SolveResult",
     "SolverOptions",
     "SolverProgress",
@@ -273,7 +279,7 @@ def generate_landmarks(preset="manhattan", **options):
 # ---- solving and certifying --------------------------------------------------
 
 
-def solve(graph, initial_rotations=None, **options):
+def solve(graph, initial_rotations=None, *, robust=False, **options):
     """Solves the pose graph with SE-Sync and certifies the result.
 
     Keyword options are SolverOptions fields, e.g. max_rank=10,
@@ -288,9 +294,29 @@ def solve(graph, initial_rotations=None, **options):
     rotations (n, d, d), translations (n, d), landmarks (L, d: the landmark
     positions, L = 0 without landmarks), and summary (the full report). With
     priors the solution is in their world frame.
+
+    robust=True: the outlier-robust solve (GNC with truncated least squares
+    around SE-Sync, robust_solver.h). Keywords may then also be
+    RobustSolverOptions fields (inlier_threshold, inlier_probability,
+    known_inliers="odometry"|"none", gnc_threshold_fractions, ...). Returns a
+    RobustResult: every RobustSolverSummary field (status, edges,
+    outlier_edges as an array, inlier_summary, history, ...), weights and
+    inliers (one per measurement), rotations and translations of the problem
+    restricted to the accepted measurements, and its objective, lower_bound,
+    relative_suboptimality_bound; certified means that problem's optimum is
+    certified (not that the TLS problem is solved globally).
     """
-    options = _options(SolverOptions, options, "solve")
-    return _core._solve(graph, options, initial_rotations)
+    if not robust:
+        options = _options(SolverOptions, options, "solve")
+        return _core._solve(graph, options, initial_rotations)
+    if initial_rotations is not None:
+        raise TypeError("solve(robust=True) does not take initial_rotations")
+    robust_fields = set(RobustSolverOptions._fields) - {"solver_options"}
+    robust_keywords = {k: v for k, v in options.items() if k in robust_fields}
+    solver_keywords = {k: v for k, v in options.items() if k not in robust_fields}
+    robust_options = _options(RobustSolverOptions, robust_keywords, "solve")
+    robust_options.solver_options = _options(SolverOptions, solver_keywords, "solve")
+    return _core._solve_robust(graph, robust_options)
 
 
 def solve_components(graph, **options):
@@ -358,6 +384,12 @@ for _cls in (
     G2oReadOptions,
     G2oReadSummary,
     LandmarkGraphOptions,
+    RobustResult,
+    RobustSolverOptions,
+    RobustSolverSummary,
+    RobustSolverSummary.Edge,
+    RobustSolverSummary.Iteration,
+    RobustSolverSummary.Run,
     SolveResult,
     SolverOptions,
     SolverProgress,
@@ -371,11 +403,12 @@ for _cls in (
     CubeOptions,
     G2oReadOptions,
     LandmarkGraphOptions,
+    RobustSolverOptions,
     SolverOptions,
     SolverProgress,
 ):
     _cls.__repr__ = _options_repr
-for _cls in (SolverSummary, ComponentsSummary):
+for _cls in (SolverSummary, ComponentsSummary, RobustSolverSummary):
     _cls.__repr__ = lambda self: f"<{type(self).__name__}: {self.brief_report}>"
 Certificate.__repr__ = lambda self: f"<{self.brief_report}>"
 SolverSummary.Level.__repr__ = lambda l: (

@@ -25,6 +25,7 @@
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/pose_graph.h"
+#include "ceres_sesync/robust_solver.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "glog/logging.h"
 #include "python/src/arrays.h"
@@ -42,6 +43,10 @@ struct SolveResult : SolverSummary {
 };
 
 struct ComponentsResult : ComponentsSummary {
+  py::object rotations, translations;
+};
+
+struct RobustResult : RobustSolverSummary {
   py::object rotations, translations;
 };
 
@@ -956,6 +961,183 @@ void InitLogging() {
   FLAGS_logtostderr = true;
 }
 
+// ---- the robust solve (robust_solver.h) ------------------------------------
+
+void BindRobust(py::module_& m) {
+  using O = RobustSolverOptions;
+  py::class_<O> options(m, "RobustSolverOptions",
+                        "ceres_sesync::RobustSolverOptions (robust_solver.h).");
+  py::enum_<O::KnownInliers> known(options, "KnownInliers",
+                                   "RobustSolverOptions::KnownInliers");
+  known.value("none", O::KnownInliers::kNone)
+      .value("odometry", O::KnownInliers::kOdometry);
+  AcceptNames(known);
+  Fields(options)
+      .rw("solver_options", &O::solver_options)
+      .rw("inlier_threshold", &O::inlier_threshold)
+      .rw("inlier_probability", &O::inlier_probability)
+      .rw("gnc_threshold_fractions", &O::gnc_threshold_fractions)
+      .rw("initial_max_rank", &O::initial_max_rank)
+      .rw("mu_step", &O::mu_step)
+      .rw("max_iterations", &O::max_iterations)
+      .rw("weight_tolerance", &O::weight_tolerance)
+      .rw("relative_cost_tolerance", &O::relative_cost_tolerance)
+      .rw("max_consistency_rounds", &O::max_consistency_rounds)
+      .rw("known_inliers", &O::known_inliers);
+  KeywordInit<O>(options, "RobustSolverOptions");
+
+  using S = RobustSolverSummary;
+  auto solver_status = [](SolverSummary::Status status) {
+    SolverSummary s;
+    s.status = status;
+    return s.StatusString();
+  };
+  auto robust_status = [](S::Status status) {
+    S s;
+    s.status = status;
+    return s.StatusString();
+  };
+  py::class_<S> cls(m, "RobustSolverSummary",
+                    "ceres_sesync::RobustSolverSummary (robust_solver.h); "
+                    "status is the string of StatusString().");
+  py::class_<S::Edge> edge(cls, "Edge", "RobustSolverSummary::Edge");
+  Fields(edge)
+      .ro("vertex_i", &S::Edge::vertex_i)
+      .ro("vertex_j", &S::Edge::vertex_j)
+      .ro("weight", &S::Edge::weight)
+      .ro("inlier", &S::Edge::inlier)
+      .ro("known_inlier", &S::Edge::known_inlier)
+      .ro("rotation_residual_deg", &S::Edge::rotation_residual_deg)
+      .ro("translation_residual", &S::Edge::translation_residual)
+      .ro("cost", &S::Edge::cost);
+  py::class_<S::Iteration> iteration(cls, "Iteration",
+                                     "RobustSolverSummary::Iteration");
+  Fields(iteration)
+      .ro("mu", &S::Iteration::mu)
+      .ro("surrogate_cost", &S::Iteration::surrogate_cost)
+      .ro("num_zero_weights", &S::Iteration::num_zero_weights)
+      .ro("num_unit_weights", &S::Iteration::num_unit_weights)
+      .get("status",
+           [solver_status](const S::Iteration& it) {
+             return solver_status(it.status);
+           })
+      .ro("rank", &S::Iteration::rank)
+      .ro("solver_iterations", &S::Iteration::solver_iterations)
+      .ro("optimization_time_s", &S::Iteration::optimization_time_s)
+      .ro("verification_time_s", &S::Iteration::verification_time_s)
+      .ro("time_s", &S::Iteration::time_s);
+  py::class_<S::Run> run(cls, "Run", "RobustSolverSummary::Run");
+  Fields(run)
+      .ro("gnc_threshold", &S::Run::gnc_threshold)
+      .get("status",
+           [robust_status](const S::Run& r) { return robust_status(r.status); })
+      .ro("iterations", &S::Run::iterations)
+      .ro("consistency_rounds", &S::Run::consistency_rounds)
+      .ro("num_outliers", &S::Run::num_outliers)
+      .ro("tls_cost", &S::Run::tls_cost)
+      .ro("certified", &S::Run::certified)
+      .ro("time_s", &S::Run::time_s);
+  Fields(cls)
+      .get("status", [](const S& s) { return s.StatusString(); })
+      .ro("message", &S::message)
+      .ro("dimension", &S::dimension)
+      .ro("num_poses", &S::num_poses)
+      .ro("num_measurements", &S::num_measurements)
+      .ro("inlier_threshold", &S::inlier_threshold)
+      .ro("gnc_threshold", &S::gnc_threshold)
+      .ro("runs", &S::runs)
+      .ro("selected_run", &S::selected_run)
+      .ro("initial_mu", &S::initial_mu)
+      .ro("iterations", &S::iterations)
+      .ro("history", &S::history)
+      .ro("weights_binary", &S::weights_binary)
+      .ro("edges", &S::edges)
+      .ro("num_inliers", &S::num_inliers)
+      .ro("num_outliers", &S::num_outliers)
+      .get("outlier_edges",
+           [](const S& s) { return IndexArray(s.outlier_edges); })
+      .ro("num_rejected_within_threshold", &S::num_rejected_within_threshold)
+      .ro("num_accepted_beyond_threshold", &S::num_accepted_beyond_threshold)
+      .ro("initial_summary", &S::initial_summary)
+      .ro("inlier_summary", &S::inlier_summary)
+      .ro("consistency_rounds", &S::consistency_rounds)
+      .ro("pattern_rebuilds", &S::pattern_rebuilds)
+      .ro("initial_time_s", &S::initial_time_s)
+      .ro("gnc_time_s", &S::gnc_time_s)
+      .ro("inlier_time_s", &S::inlier_time_s)
+      .ro("total_time_s", &S::total_time_s)
+      .get("certified", &S::certified);
+  cls.def_property_readonly("brief_report", &S::BriefReport)
+      .def("full_report", &S::FullReport, py::arg("all_edges") = false);
+
+  py::class_<RobustResult, S> result(
+      m, "RobustResult",
+      "solve(robust=True)'s result: every RobustSolverSummary field, the "
+      "poses as numpy arrays, the weights and inlier flags as arrays, the "
+      "inlier problem's objective and bounds, and summary (the full "
+      "report).");
+  Fields(result)
+      .ro("rotations", &RobustResult::rotations,
+          "(n, d, d) rotations of the inlier problem's solution")
+      .ro("translations", &RobustResult::translations,
+          "(n, d) translations of the inlier problem's solution");
+  // The inlier problem's numbers under the names solve() returns them
+  // (certified and status stay RobustSolverSummary's: the inlier problem's
+  // certificate, and GNC's outcome).
+  result
+      .def_property_readonly(
+          "objective",
+          [](const RobustResult& r) { return r.inlier_summary.objective; })
+      .def_property_readonly(
+          "lower_bound",
+          [](const RobustResult& r) { return r.inlier_summary.lower_bound; })
+      .def_property_readonly("suboptimality_bound",
+                             [](const RobustResult& r) {
+                               return r.inlier_summary.suboptimality_bound;
+                             })
+      .def_property_readonly(
+          "relative_suboptimality_bound",
+          [](const RobustResult& r) {
+            return r.inlier_summary.relative_suboptimality_bound;
+          })
+      .def_property_readonly("relaxation_exact", [](const RobustResult& r) {
+        return r.inlier_summary.relaxation_exact;
+      });
+  result.def_property_readonly("weights", [](const RobustResult& r) {
+    DoubleArray w(static_cast<py::ssize_t>(r.edges.size()));
+    for (size_t k = 0; k < r.edges.size(); ++k) {
+      w.mutable_data()[k] = r.edges[k].weight;
+    }
+    return w;
+  });
+  result.def_property_readonly("inliers", [](const RobustResult& r) {
+    py::array_t<bool> a(static_cast<py::ssize_t>(r.edges.size()));
+    for (size_t k = 0; k < r.edges.size(); ++k) {
+      a.mutable_data()[k] = r.edges[k].inlier;
+    }
+    return a;
+  });
+  result.def_property_readonly(
+      "summary", [](const RobustResult& r) { return r.FullReport(); });
+
+  m.def("_solve_robust",
+        [](const PoseGraph& graph, RobustSolverOptions options) {
+          MakeInterruptible(&options.solver_options);
+          RobustResult result;
+          Poses poses;
+          {
+            py::gil_scoped_release release;
+            poses = SolveRobust(graph, options, &result);
+          }
+          if (result.status == RobustSolverSummary::Status::kInvalidInput) {
+            InputError(result.message);
+          }
+          result.rotations = RotationsArray(poses, graph.dimension);
+          result.translations = TranslationsArray(poses, graph.dimension);
+          return result;
+        });
+}
+
 }  // namespace
 
 }  // namespace ceres_sesync::python
@@ -978,4 +1160,5 @@ PYBIND11_MODULE(_ceres_sesync, m) {
   BindCube(m);
   BindLandmarkGenerator(m);
   BindSolvers(m);
+  BindRobust(m);
 }

@@ -28,6 +28,11 @@ STRUCTS = [
     ("g2o_io.h", "G2oReadOptions", cs.G2oReadOptions),
     ("g2o_io.h", "G2oReadSummary", cs.G2oReadSummary),
     ("pose_graph.h", "PoseGraph", cs.PoseGraph),
+    ("robust_solver.h", "RobustSolverOptions", cs.RobustSolverOptions),
+    ("robust_solver.h", "RobustSolverSummary", cs.RobustSolverSummary),
+    ("robust_solver.h", "Edge", cs.RobustSolverSummary.Edge),
+    ("robust_solver.h", "Iteration", cs.RobustSolverSummary.Iteration),
+    ("robust_solver.h", "Run", cs.RobustSolverSummary.Run),
     ("pose_graph.h", "RelativePoseMeasurement", cs.Measurements),
 ]
 
