@@ -84,8 +84,8 @@ def test_options_by_keyword():
 
 def test_option_errors():
     g, _, _ = cs.generate_cube(side=2, seed=0)
-    with pytest.raises(TypeError, match=r"^solve\(\) got an unexpected keyword argument 'robust'$"):
-        cs.solve(g, robust=True)
+    with pytest.raises(TypeError, match=r"^solve\(\) got an unexpected keyword argument 'robustness'$"):
+        cs.solve(g, robustness=True)
     with pytest.raises(TypeError, match="max_rank must be int, not str"):
         cs.solve(g, max_rank="10")
     choices = "initialization must be one of 'chordal', 'random', 'vertices', not 'chordial'"
