@@ -1,8 +1,15 @@
 #include "bench/bench_util.h"
 
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -88,6 +95,73 @@ std::string CeresStatus(const CeresBaselineSummary& summary) {
     return "no_convergence";
   }
   return ceres::TerminationTypeToString(c.termination_type);
+}
+
+bool RunInChildProcess(double timeout_s, double max_memory_gb,
+                       const std::function<void(void* buffer)>& child,
+                       void* out, size_t size, std::string* failure) {
+  int fds[2];
+  if (pipe(fds) != 0) {
+    *failure = std::string("pipe: ") + std::strerror(errno);
+    return false;
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = fork();
+  if (pid < 0) {
+    *failure = std::string("fork: ") + std::strerror(errno);
+    close(fds[0]);
+    close(fds[1]);
+    return false;
+  }
+  if (pid == 0) {
+    close(fds[0]);
+    alarm(static_cast<unsigned>(std::max(1.0, timeout_s)));
+    if (max_memory_gb > 0) {
+      const rlim_t bytes =
+          static_cast<rlim_t>(max_memory_gb * 1024 * 1024 * 1024);
+      const struct rlimit limit = {bytes, bytes};
+      setrlimit(RLIMIT_AS, &limit);
+    }
+    std::vector<char> buffer(size);
+    child(buffer.data());
+    const char* p = buffer.data();
+    size_t left = size;
+    while (left > 0) {
+      const ssize_t k = write(fds[1], p, left);
+      if (k <= 0) _exit(3);
+      p += k;
+      left -= k;
+    }
+    _exit(0);
+  }
+  close(fds[1]);
+  char* p = static_cast<char*>(out);
+  size_t got = 0;
+  while (got < size) {
+    const ssize_t k = read(fds[0], p + got, size - got);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) break;
+    got += k;
+  }
+  close(fds[0]);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (got == size && WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+    return true;
+  }
+  if (WIFSIGNALED(status)) {
+    const int sig = WTERMSIG(status);
+    *failure = sig == SIGALRM ? "killed at --child_timeout"
+                              : "killed by signal " + std::to_string(sig) +
+                                    " (" + strsignal(sig) + ")";
+  } else {
+    *failure = "child exited with " +
+               std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+               " (memory limit?)";
+  }
+  return false;
 }
 
 }  // namespace ceres_sesync::bench

@@ -1,12 +1,16 @@
 // Helpers shared by the benchmark programs (bench.cc, cube_sweep.cc,
-// scaling.cc): timing, order statistics, formatting, peak memory, and the
-// short form of a Ceres termination.
+// scaling.cc, outliers.cc, ...): timing, order statistics, formatting, peak
+// memory, runs in a child process, and the short form of a Ceres
+// termination.
 
 #ifndef CERES_SESYNC_BENCH_BENCH_UTIL_H_
 #define CERES_SESYNC_BENCH_BENCH_UTIL_H_
 
 #include <chrono>
+#include <cstddef>
+#include <functional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "ceres_sesync/ceres_baseline.h"
@@ -38,6 +42,27 @@ std::vector<double> ParseDoubles(const std::string& s);
 // Peak resident set size of this process so far (VmHWM of
 // /proc/self/status), in MiB; NaN if unavailable.
 double PeakRssMiB();
+
+// Runs `child` in a forked process (SIGALRM after timeout_s seconds, at
+// least 1; address space limited to max_memory_gb GiB if > 0), which writes
+// `size` bytes to the buffer it is given; they are copied into `out` through
+// a pipe. Returns true if the child sent them and exited with 0; otherwise
+// false with the reason in *failure ("killed at --child_timeout", "killed by
+// signal N (name)", "child exited with N (memory limit?)", or the failed
+// system call).
+bool RunInChildProcess(double timeout_s, double max_memory_gb,
+                       const std::function<void(void* buffer)>& child,
+                       void* out, size_t size, std::string* failure);
+// The same for a trivially copyable result returned by fn().
+template <typename Result, typename Fn>
+bool RunInChildProcess(double timeout_s, double max_memory_gb, Fn&& fn,
+                       Result* result, std::string* failure) {
+  static_assert(std::is_trivially_copyable_v<Result>);
+  return RunInChildProcess(
+      timeout_s, max_memory_gb,
+      [&fn](void* buffer) { *static_cast<Result*>(buffer) = fn(); }, result,
+      sizeof(Result), failure);
+}
 
 // How a Ceres solve ended: converged, timeout, max_iterations,
 // no_convergence, or Ceres's termination type.

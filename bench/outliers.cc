@@ -47,11 +47,6 @@
 // printed); bench/plot_outliers.py draws NAME_random.png and
 // NAME_clustered.png from the CSV.
 
-#include <signal.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -291,69 +286,14 @@ RunResult RunMethod(const Dataset& data, const Cell& cell) {
 
 bool RunInChild(const Dataset& data, const Cell& cell, RunResult* result) {
   *result = RunResult();
-  int fds[2];
-  if (pipe(fds) != 0) {
-    SetStatus(result, std::string("pipe: ") + std::strerror(errno));
-    return false;
-  }
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const pid_t pid = fork();
-  if (pid < 0) {
-    SetStatus(result, std::string("fork: ") + std::strerror(errno));
-    close(fds[0]);
-    close(fds[1]);
-    return false;
-  }
-  if (pid == 0) {
-    close(fds[0]);
-    alarm(static_cast<unsigned>(std::max(1.0, FLAGS_child_timeout)));
-    if (FLAGS_max_memory_gb > 0) {
-      const rlim_t bytes =
-          static_cast<rlim_t>(FLAGS_max_memory_gb * 1024 * 1024 * 1024);
-      const struct rlimit limit = {bytes, bytes};
-      setrlimit(RLIMIT_AS, &limit);
-    }
-    const RunResult r = RunMethod(data, cell);
-    const char* p = reinterpret_cast<const char*>(&r);
-    size_t left = sizeof(r);
-    while (left > 0) {
-      const ssize_t k = write(fds[1], p, left);
-      if (k <= 0) _exit(3);
-      p += k;
-      left -= k;
-    }
-    _exit(0);
-  }
-  close(fds[1]);
-  char* p = reinterpret_cast<char*>(result);
-  size_t got = 0;
-  while (got < sizeof(*result)) {
-    const ssize_t k = read(fds[0], p + got, sizeof(*result) - got);
-    if (k < 0 && errno == EINTR) continue;
-    if (k <= 0) break;
-    got += k;
-  }
-  close(fds[0]);
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (got == sizeof(*result) && WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+  std::string failure;
+  if (bench::RunInChildProcess(
+          FLAGS_child_timeout, FLAGS_max_memory_gb,
+          [&] { return RunMethod(data, cell); }, result, &failure)) {
     return !std::isnan(result->time_s);
   }
   *result = RunResult();
-  if (WIFSIGNALED(status)) {
-    const int sig = WTERMSIG(status);
-    SetStatus(result, sig == SIGALRM ? "killed at --child_timeout"
-                                     : std::string("killed by signal ") +
-                                           std::to_string(sig) + " (" +
-                                           strsignal(sig) + ")");
-  } else {
-    SetStatus(result,
-              "failed (exit " +
-                  std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
-                  "; memory limit?)");
-  }
+  SetStatus(result, failure);
   return false;
 }
 
