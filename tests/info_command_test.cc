@@ -215,7 +215,8 @@ TEST_F(InfoCommandTest, CountsLandmarksAndPriors) {
             "EDGE_PRIOR_SE2_XY 0 0 0 9 0 9\n"
             "EDGE_PRIOR_SE2 1 1 0 0 0 0 0 0 0 3\n"
             "EDGE_PRIOR_SE2 0 0 0 0 1 0 0 1 0 3\n");
-  const RunResult run = RunToolWithOutput("info " + graph + " --json " + json_path);
+  const RunResult run =
+      RunToolWithOutput("info " + graph + " --json " + json_path);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ValueAfter(run.output, "landmarks:"), "2") << run.output;
   EXPECT_EQ(ValueAfter(run.output, "landmark measurements:"), "3");
