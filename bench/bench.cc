@@ -466,12 +466,7 @@ int main(int argc, char** argv) {
       "bench [--quick] [--repeats N] [--out_dir DIR] [--methods LIST] "
       "[files...]\n"
       "SE-Sync vs Ceres PDL-GN/LM on pose-graph datasets.");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  google::InitGoogleLogging(argv[0]);
-  FLAGS_logtostderr = true;
-  if (FLAGS_minloglevel < google::GLOG_WARNING) {
-    FLAGS_minloglevel = google::GLOG_WARNING;
-  }
+  bench::InitBenchProgram(&argc, &argv);
 
   std::set<std::string> methods;
   {

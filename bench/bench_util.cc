@@ -13,6 +13,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "gflags/gflags.h"
+#include "glog/logging.h"
+
 namespace ceres_sesync::bench {
 
 double SecondsSince(Clock::time_point start) {
@@ -95,6 +98,15 @@ std::string CeresStatus(const CeresBaselineSummary& summary) {
     return "no_convergence";
   }
   return ceres::TerminationTypeToString(c.termination_type);
+}
+
+void InitBenchProgram(int* argc, char*** argv) {
+  gflags::ParseCommandLineFlags(argc, argv, /*remove_flags=*/true);
+  google::InitGoogleLogging((*argv)[0]);
+  FLAGS_logtostderr = true;
+  if (FLAGS_minloglevel < google::GLOG_WARNING) {
+    FLAGS_minloglevel = google::GLOG_WARNING;
+  }
 }
 
 bool RunInChildProcess(double timeout_s, double max_memory_gb,

@@ -19,6 +19,11 @@ namespace ceres_sesync::bench {
 
 using Clock = std::chrono::steady_clock;
 
+// A bench program's start: parses its flags (removing them from argv),
+// starts glog on stderr, and shows only warnings and errors of the library
+// unless --minloglevel asks for less.
+void InitBenchProgram(int* argc, char*** argv);
+
 // Wall-clock seconds since `start`.
 double SecondsSince(Clock::time_point start);
 

@@ -245,12 +245,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "cube_sweep [--quick] [--realizations N] [--out_dir DIR]\n"
       "Figure 3 of the SE-Sync paper: cube experiments, SE-Sync vs Ceres.");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  google::InitGoogleLogging(argv[0]);
-  FLAGS_logtostderr = true;
-  if (FLAGS_minloglevel < google::GLOG_WARNING) {
-    FLAGS_minloglevel = google::GLOG_WARNING;
-  }
+  bench::InitBenchProgram(&argc, &argv);
 
   CubeOptions defaults;  // kappa 16.67, tau 75, pLC 0.1, s 10.
   defaults.loop_closure_radius = FLAGS_loop_closure_radius;

@@ -298,12 +298,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "landmarks [--quick] [--cases LIST] [--repeats N] [--out_dir DIR] ...\n"
       "SE-Sync vs Ceres PDL-GN/LM on generated landmark-SLAM graphs.");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  google::InitGoogleLogging(argv[0]);
-  FLAGS_logtostderr = true;
-  if (FLAGS_minloglevel < google::GLOG_WARNING) {
-    FLAGS_minloglevel = google::GLOG_WARNING;
-  }
+  bench::InitBenchProgram(&argc, &argv);
   if (argc > 1) {
     std::fprintf(stderr, "landmarks: unexpected argument '%s'\n", argv[1]);
     return 2;

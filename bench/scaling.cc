@@ -319,12 +319,7 @@ int main(int argc, char** argv) {
       "scaling [--quick] [--families city2d,city3d,cube] [--methods "
       "sesync,pdl,lm] [--out_dir DIR] ...\n"
       "SE-Sync vs Ceres PDL-GN/LM as n grows (one child process per run).");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  google::InitGoogleLogging(argv[0]);
-  FLAGS_logtostderr = true;
-  if (FLAGS_minloglevel < google::GLOG_WARNING) {
-    FLAGS_minloglevel = google::GLOG_WARNING;
-  }
+  bench::InitBenchProgram(&argc, &argv);
   if (argc > 1) {
     std::fprintf(stderr, "scaling: unexpected argument '%s'\n", argv[1]);
     return 2;
