@@ -356,33 +356,44 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   if (!problem.staircase().Initialize(nullptr, &Y0)) return invalid();
   problem.staircase().Run(&Y0);
   Poses poses0 = problem.staircase().Round(Y0).poses;
-  const std::vector<double> f0 = Costs(graph, poses0);
-  double max_cost = 0;
-  for (size_t k = 0; k < m; ++k) {
-    if (!known[k]) max_cost = std::max(max_cost, f0[k]);
-  }
-  solve_options.max_rank = options.solver_options.max_rank;
-  if (max_cost <= c2) {
-    // Every measurement fits: this is the inlier problem. The staircase
-    // continues where a rank cap stopped it (as Solve() would).
-    if (problem.summary().status == SolverSummary::Status::kMaxRankReached &&
-        problem.summary().final_rank < solve_options.max_rank) {
-      problem.staircase().Run(&Y0);
-      poses0 = problem.staircase().Round(Y0).poses;
+  auto max_estimated_cost = [&](const std::vector<double>& f) {
+    double max_f = 0;
+    for (size_t k = 0; k < m; ++k) {
+      if (!known[k]) max_f = std::max(max_f, f[k]);
     }
-    problem.staircase().Report(Y0, Solution{poses0, {}});
-    s.initial_summary = s.inlier_summary = problem.summary();
-    s.initial_time_s = s.total_time_s = Seconds(start);
+    return max_f;
+  };
+  std::vector<double> f0 = Costs(graph, poses0);
+  double max_cost = max_estimated_cost(f0);
+  solve_options.max_rank = options.solver_options.max_rank;
+  if (max_cost <= c2 &&
+      problem.summary().status == SolverSummary::Status::kMaxRankReached &&
+      problem.summary().final_rank < solve_options.max_rank) {
+    // Every measurement fits: perhaps this is the inlier problem. The
+    // staircase continues where a rank cap stopped it (as Solve() would).
+    problem.staircase().Run(&Y0);
+    poses0 = problem.staircase().Round(Y0).poses;
+    f0 = Costs(graph, poses0);
+    max_cost = max_estimated_cost(f0);
+  }
+  problem.staircase().Report(Y0, Solution{poses0, {}});
+  s.initial_summary = problem.summary();
+  s.initial_time_s = Seconds(start);
+  if (max_cost <= c2 && problem.summary().certified()) {
+    // Every measurement fits the certified optimum of the whole problem:
+    // accepting all of them is TLS-consistent, and this is the inlier
+    // problem. (Uncertified, e.g. an inexact relaxation because a wrong
+    // closure bends the map until it fits, GNC runs at the thresholds
+    // below the largest f_k.)
+    s.inlier_summary = problem.summary();
+    s.total_time_s = Seconds(start);
     s.weights_binary = true;
     FillEdges(graph, poses0, MeasurementWeights(m, 1.0), known,
               std::vector<char>(m, 1), c2, &s);
     return finish(RobustSolverSummary::Status::kConverged, poses0);
   }
-  problem.staircase().Report(Y0, Solution{poses0, {}});
-  s.initial_summary = problem.summary();
-  s.initial_time_s = Seconds(start);
   const double g0 = options.gnc_threshold_fractions[0] * c2;
-  s.initial_mu = g0 / (2 * max_cost - g0);
+  if (max_cost > g0) s.initial_mu = g0 / (2 * max_cost - g0);
 
   // GNC (Yang et al. 2020, Algorithm 1 with TLS) as in GTSAM's
   // GncOptimizer, from the first solve, at GNC threshold g2: weights from
@@ -394,6 +405,19 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     GncRun run;
     run.record.gnc_threshold = fraction * c2;
     const double g2 = run.record.gnc_threshold;
+    if (max_cost <= g2) {
+      // Every TLS weight is 1 at any mu: GNC would solve the first problem
+      // again. Its result stands for this run (consistent at c^2 >= g^2).
+      run.poses = poses0;
+      run.weights.assign(m, 1.0);
+      run.accepted.assign(m, 1);
+      run.weights_binary = true;
+      run.inlier_summary = s.initial_summary;
+      run.record.tls_cost = TlsCost(f0, known, c2);
+      run.record.certified = run.inlier_summary.certified();
+      run.record.time_s = Seconds(run_start);
+      return run;
+    }
     Eigen::MatrixXd Y = Y0;
     run.poses = poses0;
     std::vector<double> f = f0;

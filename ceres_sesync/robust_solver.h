@@ -39,6 +39,10 @@
 // rebuilt without them (their fill is the dominant cost). The first solve
 // (all weights 1) seeds mu_0 = g^2 / (2 max_k f_k - g^2) with its residuals
 // (g^2: GNC's threshold), then mu <- mu_step * mu after every weight update.
+// If every f_k of the first solve is within c^2 and it is certified, it is
+// the answer (nothing rejected); uncertified (a wrong closure can bend a
+// small map until it fits, leaving the relaxation inexact), GNC runs at
+// each threshold g^2 below the largest f_k (above it every weight stays 1).
 // GNC stops when the weights are binary (each within weight_tolerance of 0
 // or 1) or the surrogate cost stalls. Then the weights are rounded (inlier
 // iff w > 1/2), the problem restricted to the accepted measurements is

@@ -174,6 +174,41 @@ TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
   }
 }
 
+// A wrong closure the map bends to fit within c^2: the first solve
+// accepts every measurement but its relaxation is not exact (not
+// certified). GNC must still run (at the fractions of c^2 below the largest
+// f_k) instead of returning the uncertified all-inlier answer; here the run
+// at 0.1 c^2 rejects exactly the injected closure and certifies. (Before
+// the fix: no GNC step, nothing rejected, not certified.)
+TEST(RobustSolver, UncertifiedFirstSolveThatFitsEveryMeasurementStartsGnc) {
+  CubeOptions cube;
+  cube.side = 3;
+  cube.kappa = 16.67;
+  cube.tau = 75;
+  cube.seed = 4;
+  PoseGraph clean;
+  ASSERT_TRUE(GenerateCube(cube, &clean, nullptr, nullptr));
+  OutlierOptions o;
+  o.fraction = 0.3;
+  o.seed = 4;
+  PoseGraph corrupted;
+  std::vector<int> added;
+  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+  RobustSolverSummary s;
+  SolveRobust(corrupted, Options(), &s);
+  // The premise: the first solve fits every measurement, uncertified.
+  ASSERT_FALSE(s.initial_summary.certified()) << s.FullReport();
+  ASSERT_EQ(s.runs.size(), 2u);
+  EXPECT_EQ(s.runs[0].iterations, 0);  // Every TLS weight 1 at c^2.
+  EXPECT_EQ(s.runs[0].num_outliers, 0);
+  EXPECT_FALSE(s.runs[0].certified);
+  EXPECT_GT(s.runs[1].iterations, 0);
+  EXPECT_EQ(s.selected_run, 1);
+  EXPECT_TRUE(s.certified()) << s.FullReport();
+  EXPECT_EQ(s.outlier_edges, added) << s.FullReport();
+  EXPECT_LT(s.runs[1].tls_cost, s.runs[0].tls_cost);
+}
+
 // The same input and options (thread count included) give the same result,
 // bitwise; so do 1 and 2 threads (the kernels' results do not depend on
 // the thread count).
