@@ -236,6 +236,13 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
   if (o.max_consistency_rounds < 0) {
     return "max_consistency_rounds must be >= 0";
   }
+  if (o.max_readmission_trials < 0) {
+    return "max_readmission_trials must be >= 0";
+  }
+  if (!(o.readmission_max_cost >= 0) ||
+      !std::isfinite(o.readmission_max_cost)) {
+    return "readmission_max_cost must be a finite number >= 0";
+  }
   if (!(o.weight_tolerance >= 0 && o.weight_tolerance < 0.5)) {
     return "weight_tolerance must be in [0, 0.5)";
   }
@@ -493,15 +500,20 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     solve_options.proof_arithmetic = options.solver_options.proof_arithmetic;
     run.accepted.assign(m, 0);
     for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
-    auto solve_accepted = [&]() {
+    // Solves the problem restricted to `set` from *Y_io (updated in place).
+    auto solve_set = [&](const std::vector<char>& set, Eigen::MatrixXd* Y_io,
+                         Poses* poses) {
       MeasurementWeights binary(m);
-      for (size_t k = 0; k < m; ++k) binary[k] = run.accepted[k] ? 1.0 : 0.0;
+      for (size_t k = 0; k < m; ++k) binary[k] = set[k] ? 1.0 : 0.0;
       if (!problem.SetWeights(binary, &message)) return false;
-      Y = ReduceRank(Y, d, r0, kRankTolerance);
-      problem.staircase().Run(&Y);
-      run.poses = problem.staircase().Round(Y).poses;
+      *Y_io = ReduceRank(*Y_io, d, r0, kRankTolerance);
+      problem.staircase().Run(Y_io);
+      *poses = problem.staircase().Round(*Y_io).poses;
       reported = false;
       return true;
+    };
+    auto solve_accepted = [&]() {
+      return solve_set(run.accepted, &Y, &run.poses);
     };
     bool binary = true;
     for (size_t k = 0; k < m; ++k) {
@@ -519,20 +531,70 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // inlier problem's optimum. Each change lowers the TLS cost (at fixed
     // poses the new set takes min(f_k, c^2) per measurement; the re-solve
     // lowers the accepted sum), so the rounds end.
-    for (int round = 0; round < options.max_consistency_rounds; ++round) {
+    auto make_consistent = [&]() {
+      for (int round = 0; round < options.max_consistency_rounds; ++round) {
+        f = Costs(graph, run.poses);
+        bool changed = false;
+        for (size_t k = 0; k < m; ++k) {
+          if (known[k] || run.accepted[k] == (f[k] <= c2)) continue;
+          run.accepted[k] = f[k] <= c2;
+          changed = true;
+        }
+        if (!changed) return true;
+        ++run.record.consistency_rounds;
+        if (!solve_accepted()) {
+          message =
+              "consistency round " + std::to_string(round + 1) + ": " + message;
+          return false;
+        }
+      }
+      return true;
+    };
+    if (!make_consistent()) return disconnected("");
+    // Re-admission trials: the rejected measurements with the smallest f_k
+    // (within readmission_max_cost c^2), one at a time, each kept iff the
+    // TLS cost at the optimum with it is lower. A rejected trial leaves the
+    // problem holding it; the accepted set's optimum is solved again at the
+    // end (from its factor: one more verification).
+    std::vector<char> tried(m, 0);
+    bool restore = false;
+    for (int trial = 0; trial < options.max_readmission_trials; ++trial) {
       f = Costs(graph, run.poses);
-      bool changed = false;
+      int candidate = -1;
       for (size_t k = 0; k < m; ++k) {
-        if (known[k] || run.accepted[k] == (f[k] <= c2)) continue;
-        run.accepted[k] = f[k] <= c2;
-        changed = true;
+        if (run.accepted[k] || known[k] || tried[k] ||
+            !(f[k] <= options.readmission_max_cost * c2)) {
+          continue;
+        }
+        if (candidate < 0 || f[k] < f[candidate]) {
+          candidate = static_cast<int>(k);
+        }
       }
-      if (!changed) break;
-      ++run.record.consistency_rounds;
-      if (!solve_accepted()) {
-        return disconnected("consistency round " + std::to_string(round + 1) +
-                            ": ");
+      if (candidate < 0) break;
+      tried[candidate] = 1;
+      ++run.record.readmission_trials;
+      std::vector<char> set = run.accepted;
+      set[candidate] = 1;
+      Eigen::MatrixXd Y_trial = Y;
+      Poses poses_trial;
+      // Adding a measurement cannot disconnect the accepted graph.
+      if (!solve_set(set, &Y_trial, &poses_trial)) {
+        return disconnected("re-admission trial: ");
       }
+      if (TlsCost(Costs(graph, poses_trial), known, c2) <
+          TlsCost(f, known, c2)) {
+        run.accepted = std::move(set);
+        Y = std::move(Y_trial);
+        run.poses = std::move(poses_trial);
+        ++run.record.readmissions;
+        restore = false;
+        if (!make_consistent()) return disconnected("");
+      } else {
+        restore = true;
+      }
+    }
+    if (restore && !solve_accepted()) {
+      return disconnected("the accepted measurements: ");
     }
     if (!reported) problem.staircase().Report(Y, Solution{run.poses, {}});
     run.inlier_summary = problem.summary();
@@ -569,6 +631,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.gnc_threshold = best.record.gnc_threshold;
   s.iterations = best.record.iterations;
   s.consistency_rounds = best.record.consistency_rounds;
+  s.readmissions = best.record.readmissions;
   s.history = std::move(best.history);
   if (!s.history.empty()) s.initial_mu = s.history[0].mu;
   s.weights_binary = best.weights_binary;
@@ -670,6 +733,10 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   line("%-34s %d accepted, %d rejected\n", "Measurements", num_inliers,
        num_outliers);
   line("%-34s %d\n", "Consistency rounds", consistency_rounds);
+  line("%-34s %d (of %d trials)\n", "Re-admitted measurements", readmissions,
+       selected_run >= 0 && selected_run < static_cast<int>(runs.size())
+           ? runs[selected_run].readmission_trials
+           : 0);
   line("%-34s %d rejected with f_k <= c^2, %d accepted with f_k > c^2\n",
        "Consistency at the result", num_rejected_within_threshold,
        num_accepted_beyond_threshold);

@@ -209,6 +209,50 @@ TEST(RobustSolver, UncertifiedFirstSolveThatFitsEveryMeasurementStartsGnc) {
   EXPECT_LT(s.runs[1].tls_cost, s.runs[0].tls_cost);
 }
 
+// Re-admission: on a small noisy cube with one wrong closure, GNC's
+// accepted set leaves out a true closure too (the map without it bends
+// away, f_k > c^2 at that optimum, so the consistency rounds keep it out);
+// re-admitting it lowers the TLS cost, and exactly the wrong closure is
+// rejected.
+TEST(RobustSolver, ReadmissionRecoversATrueClosureAndLowersTheTlsCost) {
+  CubeOptions cube;
+  cube.side = 3;
+  cube.kappa = 16.67;
+  cube.tau = 75;
+  cube.seed = 3;
+  PoseGraph clean;
+  ASSERT_TRUE(GenerateCube(cube, &clean, nullptr, nullptr));
+  OutlierOptions o;
+  o.fraction = 0.3;
+  o.seed = 3;
+  PoseGraph corrupted;
+  std::vector<int> added;
+  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+  RobustSolverOptions options = Options();
+  options.max_readmission_trials = 0;
+  RobustSolverSummary without;
+  SolveRobust(corrupted, options, &without);
+  // The premise: without re-admission a true closure is rejected as well.
+  ASSERT_TRUE(without.certified()) << without.FullReport();
+  ASSERT_GT(without.num_outliers, static_cast<int>(added.size()));
+  EXPECT_EQ(without.readmissions, 0);
+  RobustSolverSummary with;
+  SolveRobust(corrupted, Options(), &with);
+  EXPECT_TRUE(with.certified()) << with.FullReport();
+  EXPECT_EQ(with.outlier_edges, added) << with.FullReport();
+  EXPECT_GE(with.readmissions, 1);
+  EXPECT_EQ(with.num_rejected_within_threshold, 0);
+  EXPECT_LT(with.runs[with.selected_run].tls_cost,
+            without.runs[without.selected_run].tls_cost);
+  // The TLS cost of the result, recomputed from its verdicts.
+  const double c2 = with.inlier_threshold;
+  double tls = 0;
+  for (const RobustSolverSummary::Edge& e : with.edges) {
+    tls += e.known_inlier ? e.cost : std::min(e.cost, c2);
+  }
+  EXPECT_NEAR(tls, with.runs[with.selected_run].tls_cost, 1e-9 * tls);
+}
+
 // The same input and options (thread count included) give the same result,
 // bitwise; so do 1 and 2 threads (the kernels' results do not depend on
 // the thread count).
@@ -317,6 +361,14 @@ TEST(RobustSolver, InvalidOptionsAndInputsAreReported) {
   options.gnc_threshold_fractions = {0.1, 2};
   SolveRobust(graph, options, &s);
   EXPECT_THAT(s.message, ::testing::HasSubstr("gnc_threshold_fractions"));
+  options = Options();
+  options.max_readmission_trials = -1;
+  SolveRobust(graph, options, &s);
+  EXPECT_THAT(s.message, ::testing::HasSubstr("max_readmission_trials"));
+  options = Options();
+  options.readmission_max_cost = std::nan("");
+  SolveRobust(graph, options, &s);
+  EXPECT_THAT(s.message, ::testing::HasSubstr("readmission_max_cost"));
   PoseGraph bad = graph;
   bad.measurements[3].kappa = -1;
   SolveRobust(bad, Options(), &s);

@@ -16,7 +16,7 @@ bool ParseKnownInliers(const std::string& name,
                        RobustSolverOptions::KnownInliers* known_inliers);
 
 // Adds to the solve's JSON: "robust": true, "robust_status",
-// "inlier_threshold", "gnc_iterations", "consistency_rounds",
+// "inlier_threshold", "gnc_iterations", "consistency_rounds", "readmissions",
 // "num_inliers", "num_outliers", "outlier_edges" (0-based indices of the
 // rejected measurements in the order of the file's EDGE lines) and "edges"
 // (one object per measurement: weight, inlier, known_inlier,

@@ -983,6 +983,8 @@ void BindRobust(py::module_& m) {
       .rw("weight_tolerance", &O::weight_tolerance)
       .rw("relative_cost_tolerance", &O::relative_cost_tolerance)
       .rw("max_consistency_rounds", &O::max_consistency_rounds)
+      .rw("max_readmission_trials", &O::max_readmission_trials)
+      .rw("readmission_max_cost", &O::readmission_max_cost)
       .rw("known_inliers", &O::known_inliers);
   KeywordInit<O>(options, "RobustSolverOptions");
 
@@ -1033,6 +1035,8 @@ void BindRobust(py::module_& m) {
            [robust_status](const S::Run& r) { return robust_status(r.status); })
       .ro("iterations", &S::Run::iterations)
       .ro("consistency_rounds", &S::Run::consistency_rounds)
+      .ro("readmission_trials", &S::Run::readmission_trials)
+      .ro("readmissions", &S::Run::readmissions)
       .ro("num_outliers", &S::Run::num_outliers)
       .ro("tls_cost", &S::Run::tls_cost)
       .ro("certified", &S::Run::certified)
@@ -1061,6 +1065,7 @@ void BindRobust(py::module_& m) {
       .ro("initial_summary", &S::initial_summary)
       .ro("inlier_summary", &S::inlier_summary)
       .ro("consistency_rounds", &S::consistency_rounds)
+      .ro("readmissions", &S::readmissions)
       .ro("pattern_rebuilds", &S::pattern_rebuilds)
       .ro("initial_time_s", &S::initial_time_s)
       .ro("gnc_time_s", &S::gnc_time_s)
