@@ -12,6 +12,7 @@
 // here from the measurements, independently of the library's matrices) gives
 // the inertia at any shift, and bisection gives lambda_min(S).
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -230,6 +231,37 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
       c.d, c.n, c.step * c.n, v.eta, internal::ProofPrecisionName(v.precision),
       true_shift, options.eta_goal);
 
+  // As the staircase calls it: with the candidate's translation spread
+  // (max over coordinates of sum_i (t_i - t_0)^2 / n) and the hint that it
+  // is probably optimal. Double cannot reach the goal here, and the one
+  // double-double factorization is all it takes (no double one); the
+  // proven shift is as sound and as tight.
+  double spread = 0;
+  for (int a = 0; a < c.d; ++a) {
+    double sum = 0;
+    for (const Pose& p : x) sum += std::pow(p.t(a) - x[0].t(a), 2);
+    spread = std::max(spread, sum / c.n);
+  }
+  internal::VerificationOptions hinted = options;
+  hinted.translation_spread = spread;
+  hinted.likely_optimal = true;
+  internal::CertificateMatrix fresh(problem);
+  const bool double_too_coarse =
+      fresh.next_double_shift() * spread > options.eta_goal / 4;
+  const internal::VerificationResult u =
+      internal::VerifyCertificate(problem, Lambda, hinted, &fresh);
+  ASSERT_TRUE(u.certified);
+  EXPECT_LE(u.eta, options.eta_goal);
+  EXPECT_EQ(reference.NegativePivots(Lambda, u.eta), 0)
+      << "FALSE CERTIFICATE: S + eta I is indefinite (eta " << u.eta << ")";
+  EXPECT_GE(u.eta, true_shift);
+  // The premise (corridors kilometres long): double's floor is above the
+  // goal.
+  EXPECT_TRUE(double_too_coarse);
+  EXPECT_EQ(u.factorizations, 0);
+  EXPECT_EQ(u.extended_factorizations, 1);
+  EXPECT_EQ(u.precision, internal::ProofPrecision::kDoubleDouble);
+
   // Teeth: multipliers raised by delta make lambda_min(S') =
   // lambda_min(S) - delta. Within the goal (delta = goal / 2) the proof must
   // still certify (tightness); beyond it (4 goal) it must not (soundness);
@@ -252,6 +284,18 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
     if (std::isfinite(w.eta)) {
       EXPECT_EQ(reference.NegativePivots(raised, w.eta), 0)
           << "FALSE CERTIFICATE at eta " << w.eta;
+    }
+    // A wrong hint (not near-optimal at 4 goal) changes the cost, not the
+    // verdict.
+    internal::VerificationOptions hinted_limit = limit;
+    hinted_limit.translation_spread = spread;
+    hinted_limit.likely_optimal = true;
+    const internal::VerificationResult h =
+        internal::VerifyCertificate(problem, raised, hinted_limit, &matrix);
+    EXPECT_EQ(h.certified, factor < 1) << "eta " << h.eta;
+    if (std::isfinite(h.eta)) {
+      EXPECT_EQ(reference.NegativePivots(raised, h.eta), 0)
+          << "FALSE CERTIFICATE at eta " << h.eta;
     }
   }
 }

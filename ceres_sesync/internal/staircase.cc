@@ -389,6 +389,8 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
     if (gap > options_.certification_goal_relative_bound) {
       verification_options.policy = ProofPolicy::kDouble;
       extended_deferred_ = true;
+    } else {
+      verification_options.likely_optimal = true;
     }
   }
   verification_options.translation_spread = TranslationSpread(

@@ -197,16 +197,17 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // (`factor_at_eta_max`), else by factors of 8, so that the proven bound
   // lands near what lambda_min(S) allows instead of at the tolerance itself
   // (where the rounded-up objective can put it just outside).
+  // Double-double proofs are attempted at increasing shifts only.
+  double tried = 0;
+  // True when done: proven, or c cannot improve on what is proven.
+  auto attempt = [&](double c) {
+    c = std::max(c, eta_target);
+    if (c >= result.eta) return true;
+    if (c <= tried) return false;
+    tried = c;
+    return prove(c, ProofPrecision::kDoubleDouble);
+  };
   auto prove_extended = [&](bool factor_at_eta_max) {
-    double tried = 0;
-    // True when done: proven, or c cannot improve on what is proven.
-    auto attempt = [&](double c) {
-      c = std::max(c, eta_target);
-      if (c >= result.eta) return true;
-      if (c <= tried) return false;
-      tried = c;
-      return prove(c, ProofPrecision::kDoubleDouble);
-    };
     if (attempt(goal / 16) || attempt(goal)) return;
     if (factor_at_eta_max) {
       const double lambda_min = estimate_lambda_min(eta_max);
@@ -242,6 +243,10 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
         result.eta <= goal) {
       return finish();
     }
+  } else if (options.likely_optimal) {
+    // Double cannot reach the goal; a probably optimal candidate goes to
+    // double-double directly (see VerificationOptions::likely_optimal).
+    if (attempt(goal / 16) && result.eta <= goal) return finish();
   }
 
   // 2. Near-optimal (lambda_min(S) > -eta_max up to round-off) or not?
