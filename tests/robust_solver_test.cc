@@ -174,6 +174,23 @@ TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
   }
 }
 
+// A 3 x 3 x 3 cube at the paper's noise (kappa 16.67, tau 75) plus random
+// wrong closures at 30% (cube and outlier seed `seed`).
+bool SmallNoisyCubeWithOutliers(uint64_t seed, PoseGraph* corrupted,
+                                std::vector<int>* added) {
+  CubeOptions cube;
+  cube.side = 3;
+  cube.kappa = 16.67;
+  cube.tau = 75;
+  cube.seed = seed;
+  PoseGraph clean;
+  if (!GenerateCube(cube, &clean, nullptr, nullptr)) return false;
+  OutlierOptions o;
+  o.fraction = 0.3;
+  o.seed = seed;
+  return AddOutliers(clean, o, corrupted, added, nullptr);
+}
+
 // A wrong closure the map bends to fit within c^2: the first solve
 // accepts every measurement but its relaxation is not exact (not
 // certified). GNC must still run (at the fractions of c^2 below the largest
@@ -181,19 +198,9 @@ TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
 // at 0.1 c^2 rejects exactly the injected closure and certifies. (Before
 // the fix: no GNC step, nothing rejected, not certified.)
 TEST(RobustSolver, UncertifiedFirstSolveThatFitsEveryMeasurementStartsGnc) {
-  CubeOptions cube;
-  cube.side = 3;
-  cube.kappa = 16.67;
-  cube.tau = 75;
-  cube.seed = 4;
-  PoseGraph clean;
-  ASSERT_TRUE(GenerateCube(cube, &clean, nullptr, nullptr));
-  OutlierOptions o;
-  o.fraction = 0.3;
-  o.seed = 4;
   PoseGraph corrupted;
   std::vector<int> added;
-  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+  ASSERT_TRUE(SmallNoisyCubeWithOutliers(4, &corrupted, &added));
   RobustSolverSummary s;
   SolveRobust(corrupted, Options(), &s);
   // The premise: the first solve fits every measurement, uncertified.
@@ -215,19 +222,9 @@ TEST(RobustSolver, UncertifiedFirstSolveThatFitsEveryMeasurementStartsGnc) {
 // re-admitting it lowers the TLS cost, and exactly the wrong closure is
 // rejected.
 TEST(RobustSolver, ReadmissionRecoversATrueClosureAndLowersTheTlsCost) {
-  CubeOptions cube;
-  cube.side = 3;
-  cube.kappa = 16.67;
-  cube.tau = 75;
-  cube.seed = 3;
-  PoseGraph clean;
-  ASSERT_TRUE(GenerateCube(cube, &clean, nullptr, nullptr));
-  OutlierOptions o;
-  o.fraction = 0.3;
-  o.seed = 3;
   PoseGraph corrupted;
   std::vector<int> added;
-  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+  ASSERT_TRUE(SmallNoisyCubeWithOutliers(3, &corrupted, &added));
   RobustSolverOptions options = Options();
   options.max_readmission_trials = 0;
   RobustSolverSummary without;
