@@ -47,7 +47,9 @@
 // or 1) or the surrogate cost stalls. Then the weights are rounded (inlier
 // iff w > 1/2), the problem restricted to the accepted measurements is
 // solved and certified, and the accepted set is made consistent with c^2
-// at that optimum (max_consistency_rounds). GNC runs once per schedule of
+// at that optimum (max_consistency_rounds), after which a few rejected
+// measurements are re-admitted where that lowers the TLS cost
+// (max_readmission_trials). GNC runs once per schedule of
 // gnc_threshold_fractions (g^2 = fraction * c^2); the result with the
 // lowest TLS cost is returned.
 //
