@@ -35,14 +35,14 @@ struct VerificationOptions {
   // singular): shifts below that are not tried in double.
   double translation_spread = 0;
   // The candidate is probably optimal (the caller's evidence: the staircase
-  // sets it when rounding Y loses at most the goal, i.e. Y is numerically of
-  // rank d). Where double cannot reach the goal (its floor, see
-  // translation_spread, is above it) and kAutomatic escalates to
-  // double-double, the double-double proof at goal / 16 is then tried first,
-  // before the near-optimality test in double (one double factorization at
-  // eta_max), which is needed only if that proof fails. A certified large
-  // map then takes one double-double factorization instead of it plus a
-  // double one; a candidate that is not near-optimal costs one failed
+  // sets it when rounding Y loses at most the goal; a lifted saddle of rank
+  // d passes that test too, and then pays the failed proof below). Where double
+  // cannot reach the goal (its floor, see translation_spread, is above it) and
+  // kAutomatic escalates to double-double, the double-double proof at goal / 16
+  // is then tried first, before the near-optimality test in double (one double
+  // factorization at eta_max), which is needed only if that proof fails. A
+  // certified large map then takes one double-double factorization instead of
+  // it plus a double one; a candidate that is not near-optimal costs one failed
   // double-double factorization more (1.6-1.7x a double one, measured).
   bool likely_optimal = false;
   // No factorization is started that is predicted to end after this
