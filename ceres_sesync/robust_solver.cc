@@ -243,6 +243,9 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
       !std::isfinite(o.readmission_max_cost)) {
     return "readmission_max_cost must be a finite number >= 0";
   }
+  if (!(o.readmission_min_gain >= 0 && o.readmission_min_gain < 1)) {
+    return "readmission_min_gain must be in [0, 1)";
+  }
   if (!(o.weight_tolerance >= 0 && o.weight_tolerance < 0.5)) {
     return "weight_tolerance must be in [0, 0.5)";
   }
@@ -553,7 +556,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     if (!make_consistent()) return disconnected("");
     // Re-admission trials: the rejected measurements with the smallest f_k
     // (within readmission_max_cost c^2), one at a time, each kept iff the
-    // TLS cost at the optimum with it is lower. A rejected trial leaves the
+    // TLS cost at the optimum with it is lower by more than
+    // readmission_min_gain c^2. A rejected trial leaves the
     // problem holding it; the accepted set's optimum is solved again at the
     // end (from its factor: one more verification).
     std::vector<char> tried(m, 0);
@@ -582,7 +586,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         return disconnected("re-admission trial: ");
       }
       if (TlsCost(Costs(graph, poses_trial), known, c2) <
-          TlsCost(f, known, c2)) {
+          TlsCost(f, known, c2) - options.readmission_min_gain * c2) {
         run.accepted = std::move(set);
         Y = std::move(Y_trial);
         run.poses = std::move(poses_trial);
