@@ -243,9 +243,6 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
       !std::isfinite(o.readmission_max_cost)) {
     return "readmission_max_cost must be a finite number >= 0";
   }
-  if (!(o.readmission_min_gain >= 0 && o.readmission_min_gain < 1)) {
-    return "readmission_min_gain must be in [0, 1)";
-  }
   if (!(o.weight_tolerance >= 0 && o.weight_tolerance < 0.5)) {
     return "weight_tolerance must be in [0, 0.5)";
   }
@@ -556,14 +553,32 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     if (!make_consistent()) return disconnected("");
     // Re-admission trials: the rejected measurements with the smallest f_k
     // (within readmission_max_cost c^2), one at a time, each kept iff the
-    // TLS cost at the optimum with it is lower by more than
-    // readmission_min_gain c^2. A rejected trial leaves the
+    // TLS cost at the optimum with it is lower and the accepted terms rise
+    // by less than c^2 scaled by the variance factor (readmission_variance_
+    // scaled). A rejected trial leaves the
     // problem holding it; the accepted set's optimum is solved again at the
     // end (from its factor: one more verification).
     std::vector<char> tried(m, 0);
     bool restore = false;
+    auto accepted_sum = [&](const std::vector<double>& costs,
+                            const std::vector<char>& set) {
+      double sum = 0;
+      for (size_t k = 0; k < m; ++k) sum += set[k] ? costs[k] : 0.0;
+      return sum;
+    };
     for (int trial = 0; trial < options.max_readmission_trials; ++trial) {
       f = Costs(graph, run.poses);
+      // The accepted set's a-posteriori variance factor at its optimum:
+      // its cost over its redundancy (d(d+1)/2 per measurement beyond a
+      // spanning tree).
+      const double accepted_cost = accepted_sum(f, run.accepted);
+      const double redundancy =
+          d * (d + 1) / 2.0 *
+          (std::count(run.accepted.begin(), run.accepted.end(), 1) -
+           graph.num_poses + 1.0);
+      const double scale = options.readmission_variance_scaled && redundancy > 0
+                               ? std::min(1.0, accepted_cost / redundancy)
+                               : 1.0;
       int candidate = -1;
       for (size_t k = 0; k < m; ++k) {
         if (run.accepted[k] || known[k] || tried[k] ||
@@ -585,8 +600,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       if (!solve_set(set, &Y_trial, &poses_trial)) {
         return disconnected("re-admission trial: ");
       }
-      if (TlsCost(Costs(graph, poses_trial), known, c2) <
-          TlsCost(f, known, c2) - options.readmission_min_gain * c2) {
+      const std::vector<double> f_trial = Costs(graph, poses_trial);
+      const double rise = accepted_sum(f_trial, set) - accepted_cost;
+      if (TlsCost(f_trial, known, c2) < TlsCost(f, known, c2) &&
+          rise < scale * c2) {
         run.accepted = std::move(set);
         Y = std::move(Y_trial);
         run.poses = std::move(poses_trial);
