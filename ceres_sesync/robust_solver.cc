@@ -243,6 +243,9 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
       !std::isfinite(o.readmission_max_cost)) {
     return "readmission_max_cost must be a finite number >= 0";
   }
+  if (!(o.readmission_min_scale >= 0 && o.readmission_min_scale <= 1)) {
+    return "readmission_min_scale must be in [0, 1]";
+  }
   if (!(o.weight_tolerance >= 0 && o.weight_tolerance < 0.5)) {
     return "weight_tolerance must be in [0, 0.5)";
   }
@@ -554,8 +557,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // Re-admission trials: the rejected measurements with the smallest f_k
     // (within readmission_max_cost c^2), one at a time, each kept iff the
     // TLS cost at the optimum with it is lower and the accepted terms rise
-    // by less than c^2 scaled by the variance factor (readmission_variance_
-    // scaled). A rejected trial leaves the
+    // by less than c^2 scaled by the variance factor (readmission_min_
+    // scale). A rejected trial leaves the
     // problem holding it; the accepted set's optimum is solved again at the
     // end (from its factor: one more verification).
     std::vector<char> tried(m, 0);
@@ -576,8 +579,9 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
           d * (d + 1) / 2.0 *
           (std::count(run.accepted.begin(), run.accepted.end(), 1) -
            graph.num_poses + 1.0);
-      const double scale = options.readmission_variance_scaled && redundancy > 0
-                               ? std::min(1.0, accepted_cost / redundancy)
+      const double scale = redundancy > 0
+                               ? std::clamp(accepted_cost / redundancy,
+                                            options.readmission_min_scale, 1.0)
                                : 1.0;
       int candidate = -1;
       for (size_t k = 0; k < m; ++k) {

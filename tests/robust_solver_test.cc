@@ -269,7 +269,7 @@ TEST(RobustSolver, ScaledReadmissionKeepsOutAWrongClosureTheMapBendsToFit) {
   ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
   ASSERT_FALSE(added.empty());
   RobustSolverOptions bare = Options();
-  bare.readmission_variance_scaled = false;
+  bare.readmission_min_scale = 1;
   RobustSolverSummary without_margin;
   SolveRobust(corrupted, bare, &without_margin);
   // The premise: a wrong closure is re-admitted and stays in.
@@ -404,6 +404,12 @@ TEST(RobustSolver, InvalidOptionsAndInputsAreReported) {
   options.readmission_max_cost = std::nan("");
   SolveRobust(graph, options, &s);
   EXPECT_THAT(s.message, ::testing::HasSubstr("readmission_max_cost"));
+  for (double scale : {-0.1, 1.5, std::nan("")}) {
+    options = Options();
+    options.readmission_min_scale = scale;
+    SolveRobust(graph, options, &s);
+    EXPECT_THAT(s.message, ::testing::HasSubstr("readmission_min_scale"));
+  }
   PoseGraph bad = graph;
   bad.measurements[3].kappa = -1;
   SolveRobust(bad, Options(), &s);

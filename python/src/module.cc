@@ -985,7 +985,7 @@ void BindRobust(py::module_& m) {
       .rw("max_consistency_rounds", &O::max_consistency_rounds)
       .rw("max_readmission_trials", &O::max_readmission_trials)
       .rw("readmission_max_cost", &O::readmission_max_cost)
-      .rw("readmission_variance_scaled", &O::readmission_variance_scaled)
+      .rw("readmission_min_scale", &O::readmission_min_scale)
       .rw("known_inliers", &O::known_inliers);
   KeywordInit<O>(options, "RobustSolverOptions");
 
