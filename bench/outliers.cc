@@ -134,6 +134,11 @@ struct RunResult {
   char status[160] = {};
 };
 
+// (T(x) - T(x*)) / T(x*): see "TLS vs truth" at the top.
+double TlsVsTruth(const RunResult& r) {
+  return (r.tls_cost - r.truth_tls_cost) / r.truth_tls_cost;
+}
+
 void SetStatus(RunResult* r, const std::string& status) {
   std::snprintf(r->status, sizeof(r->status), "%s", status.c_str());
 }
@@ -426,10 +431,8 @@ int Main() {
               Fmt("%.3g", r.max_rotation_error_deg).c_str(),
               Fmt("%.3g", r.max_translation_error).c_str(),
               Fmt("%.2e", r.clean_gap).c_str(),
-              Fmt("%.2e", (r.tls_cost - r.truth_tls_cost) / r.truth_tls_cost)
-                  .c_str(),
-              Fmt("%.3f", r.time_s).c_str(), r.status,
-              row.ok && Success(r) ? "  ok" : "");
+              Fmt("%.2e", TlsVsTruth(r)).c_str(), Fmt("%.3f", r.time_s).c_str(),
+              r.status, row.ok && Success(r) ? "  ok" : "");
           std::fflush(stdout);
           csv << CsvField(name) << "," << data.graph.dimension << ","
               << data.graph.num_poses << "," << data.graph.measurements.size()
@@ -500,7 +503,7 @@ int Main() {
           rot.push_back(r.max_rotation_error_deg);
           trans.push_back(r.max_translation_error);
           gap.push_back(r.clean_gap);
-          tls.push_back((r.tls_cost - r.truth_tls_cost) / r.truth_tls_cost);
+          tls.push_back(TlsVsTruth(r));
           time.push_back(r.time_s);
         }
         md << "| " << data.name << " | " << mode << " | " << fraction << " | "

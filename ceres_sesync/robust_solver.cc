@@ -557,10 +557,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // Re-admission trials: the rejected measurements with the smallest f_k
     // (within readmission_max_cost c^2), one at a time, each kept iff the
     // TLS cost at the optimum with it is lower and the accepted terms rise
-    // by less than c^2 scaled by the variance factor (readmission_min_
-    // scale). A rejected trial leaves the
-    // problem holding it; the accepted set's optimum is solved again at the
-    // end (from its factor: one more verification).
+    // by less than c^2 scaled by the variance factor
+    // (readmission_min_scale). A rejected trial leaves the problem holding
+    // it; the accepted set's optimum is solved again at the end (from its
+    // factor: one more verification).
     std::vector<char> tried(m, 0);
     bool restore = false;
     auto accepted_sum = [&](const std::vector<double>& costs,

@@ -152,14 +152,13 @@ struct RobustSolverOptions {
   // with f_k <= readmission_max_cost c^2, at most max_readmission_trials of
   // them (0: off), are tried one at a time: the accepted set plus the
   // measurement is solved, and kept iff the TLS cost at its optimum is
-  // lower and the rise it causes is small (readmission_min_scale;
-  // then the consistency rounds run again). A trial costs one solve (from the
-  // current factor); one more restores the accepted set's optimum if the last
-  // trial was not kept. Measured: tinyGrid3D with one wrong closure (generate
-  // outliers
-  // --fraction 0.3 --seed 1) rejected it and one true closure (f_k = 3.6
-  // c^2 at that optimum; TLS cost 83.9); re-admitting the true closure
-  // gives the clean optimum plus c^2 (56.8).
+  // lower and the rise it causes is small (readmission_min_scale; then
+  // the consistency rounds run again). A trial costs one solve (from the
+  // current factor); one more restores the accepted set's optimum if the
+  // last trial was not kept. Measured: tinyGrid3D with one wrong closure
+  // (`generate outliers --fraction 0.3 --seed 1`) rejected it and one true
+  // closure (f_k = 3.6 c^2 at that optimum; TLS cost 83.9); re-admitting
+  // the true closure gives the clean optimum plus c^2 (56.8).
   int max_readmission_trials = 5;
   double readmission_max_cost = 10;
   // A trial is kept iff it lowers the TLS cost and dF, the rise of the

@@ -270,22 +270,22 @@ TEST(RobustSolver, ScaledReadmissionKeepsOutAWrongClosureTheMapBendsToFit) {
   ASSERT_FALSE(added.empty());
   RobustSolverOptions bare = Options();
   bare.readmission_min_scale = 1;
-  RobustSolverSummary without_margin;
-  SolveRobust(corrupted, bare, &without_margin);
+  RobustSolverSummary bare_rule;
+  SolveRobust(corrupted, bare, &bare_rule);
   // The premise: a wrong closure is re-admitted and stays in.
-  ASSERT_GE(without_margin.readmissions, 1) << without_margin.FullReport();
+  ASSERT_GE(bare_rule.readmissions, 1) << bare_rule.FullReport();
   int accepted_wrong = 0;
-  for (int k : added) accepted_wrong += without_margin.edges[k].inlier;
-  ASSERT_GE(accepted_wrong, 1) << without_margin.FullReport();
-  RobustSolverSummary with_margin;
-  SolveRobust(corrupted, Options(), &with_margin);
-  EXPECT_TRUE(with_margin.certified()) << with_margin.FullReport();
-  EXPECT_EQ(with_margin.outlier_edges, added) << with_margin.FullReport();
-  EXPECT_EQ(with_margin.readmissions, 0);
+  for (int k : added) accepted_wrong += bare_rule.edges[k].inlier;
+  ASSERT_GE(accepted_wrong, 1) << bare_rule.FullReport();
+  RobustSolverSummary scaled;
+  SolveRobust(corrupted, Options(), &scaled);
+  EXPECT_TRUE(scaled.certified()) << scaled.FullReport();
+  EXPECT_EQ(scaled.outlier_edges, added) << scaled.FullReport();
+  EXPECT_EQ(scaled.readmissions, 0);
   // The TLS cost itself prefers the bent map (the wrong closure costs
   // less than c^2 there): the scaling, not the TLS rule, keeps it out.
-  EXPECT_LT(without_margin.runs[without_margin.selected_run].tls_cost,
-            with_margin.runs[with_margin.selected_run].tls_cost);
+  EXPECT_LT(bare_rule.runs[bare_rule.selected_run].tls_cost,
+            scaled.runs[scaled.selected_run].tls_cost);
 }
 
 // The same input and options (thread count included) give the same result,
