@@ -12,6 +12,7 @@
 #include "ceres/loss_function.h"
 #include "ceres/manifold.h"
 #include "ceres/types.h"
+#include "ceres_sesync/internal/openmp_teams.h"
 
 namespace ceres_sesync {
 
@@ -483,7 +484,13 @@ bool SolveWithCeres(const PoseGraph& graph, const Solution& initial,
   }
 
   ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver_options, &problem, &ceres_summary);
+  {
+    // Its sparse Cholesky is CHOLMOD's supernodal one: the same OpenMP teams
+    // as in SE-Sync's factorizations, kept to one thread the same way
+    // (openmp_teams.h), so the two are compared on equal terms.
+    internal::ScopedSerialOpenMpTeams serial_teams;
+    ceres::Solve(solver_options, &problem, &ceres_summary);
+  }
   if (ceres_summary.termination_type == ceres::FAILURE ||
       !ceres_summary.IsSolutionUsable()) {
     return fail("Ceres failed: " + ceres_summary.message);

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "ceres_sesync/internal/openmp_teams.h"
 #include "ceres_sesync/internal/parallel.h"
 #include "glog/logging.h"
 
@@ -152,6 +153,11 @@ void CholmodFactor::BackwardErrorBound(int split, double* head_bound,
     double& side = i < split ? *head_bound : *tail_bound;
     side = std::max(side, rho[i]);
   }
+}
+
+void CholmodFactor::factorize(const SparseMatrix& matrix) {
+  ScopedSerialOpenMpTeams serial_teams;
+  Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>::factorize(matrix);
 }
 
 SparseCholeskyFactor CholmodFactor::ExtractFactor() {

@@ -46,6 +46,10 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 class CholmodFactor
     : public Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> {
  public:
+  // Eigen's numeric factorization, with CHOLMOD's OpenMP teams of one thread
+  // (openmp_teams.h): supernodal factorizations up to 2x faster, the same
+  // factor.
+  void factorize(const SparseMatrix& matrix);
   // After a successful LL^T factorization P A P^T = L L^T + E: bounds on the
   // floating-point backward error E such that
   //   A + diag(head_bound I, tail_bound I) is positive semidefinite,
