@@ -617,6 +617,45 @@ TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
 
 // The preconditioners: the documented dense operators, and symmetric positive
 // definite on the tangent space (the operator Proj o P o Proj).
+// ReleaseNumericFactor() frees the values and keeps the symbolic analysis:
+// a copy taken before stays valid, and refactorizing (simplicial or
+// supernodal) gives the same factor to the last bit.
+TEST(CholmodFactor, ReleaseKeepsAnalysisAndCopies) {
+  std::mt19937_64 rng(41);
+  for (const PoseGraph& graph : CostGraphs()) {
+    SESyncProblem problem(graph);
+    ASSERT_TRUE(problem.ok());
+    internal::SparseMatrix identity(problem.D().rows(), problem.D().cols());
+    identity.setIdentity();
+    const internal::SparseMatrix A = problem.D() + identity;
+    const MatrixXd B = Gaussian(static_cast<int>(A.rows()), 2, &rng);
+    for (auto layout : {internal::CholmodLayout::kSimplicial,
+                        internal::CholmodLayout::kSupernodal}) {
+      internal::CholmodFactor factor;
+      internal::ConfigureCholmod(layout, &factor);
+      factor.analyzePattern(A);
+      EXPECT_FALSE(factor.HasNumericFactor());
+      factor.factorize(A);
+      ASSERT_TRUE(factor.HasNumericFactor());
+      const MatrixXd X = factor.solve(B);
+      const internal::SparseCholeskyFactor copy = factor.ExtractFactor();
+      factor.ReleaseNumericFactor();
+      EXPECT_FALSE(factor.HasNumericFactor());
+      MatrixXd X_copy;
+      copy.SolveRows(B.transpose(), &X_copy);
+      EXPECT_LT(RelativeError(X_copy.transpose(), X), 1e-12);
+      factor.factorize(A);
+      ASSERT_EQ(factor.info(), Eigen::Success);
+      ASSERT_TRUE(factor.HasNumericFactor());
+      const MatrixXd X_again = factor.solve(B);
+      EXPECT_TRUE((X_again.array() == X.array()).all());
+      EXPECT_LT(RelativeError(
+                    MatrixXd(A.selfadjointView<Eigen::Lower>() * X_again), B),
+                1e-10);
+    }
+  }
+}
+
 TEST(SESyncPreconditioner, AllTypesAreDocumentedOperatorsAndSpdOnTangent) {
   std::mt19937_64 rng(31);
   for (const PoseGraph& graph : CostGraphs()) {

