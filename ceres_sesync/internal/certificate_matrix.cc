@@ -201,6 +201,9 @@ void CertificateMatrix::FactorizeDouble() {
   last_double_seconds_ =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
+  if (factor_.info() == Eigen::Success) {
+    complete_double_seconds_ = last_double_seconds_;
+  }
 }
 
 bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c) {

@@ -108,6 +108,10 @@ class CertificateMatrix {
   // last one's time, same pattern; double-double before its first run:
   // 3.4x the double time, the measured upper end); 0 if unknown.
   double PredictedSeconds(ProofPrecision precision) const;
+  // Seconds of the last double factorization that completed (a failed one
+  // stops early, so its time can be far below a full factorization's); 0
+  // if none has.
+  double complete_double_seconds() const { return complete_double_seconds_; }
 
   // Factorizations so far, by arithmetic, and the seconds spent in the
   // double-double ones (including their assembly and symbolic analysis).
@@ -158,6 +162,7 @@ class CertificateMatrix {
   int double_factorizations_ = 0, extended_factorizations_ = 0;
   double extended_time_s_ = 0;
   double last_double_seconds_ = 0, last_extended_seconds_ = 0;
+  double complete_double_seconds_ = 0;
   std::chrono::steady_clock::time_point deadline_ =
       std::chrono::steady_clock::time_point::max();
   bool timed_out_ = false;

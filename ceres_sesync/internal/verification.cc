@@ -1,5 +1,6 @@
 #include "ceres_sesync/internal/verification.h"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -58,15 +59,22 @@ class CertificateOperator {
 // unit vector v, result->direction_curvature = v^T S v < 0 and
 // result->lambda_min_estimate the same Rayleigh quotient (>= lambda_min(S)),
 // when it converged to a negative eigenvalue; else leaves *result alone.
+// FindNegativeCurvature's Lanczos: a basis of kLanczosBasis vectors and at
+// most kLanczosRestarts restarts, i.e. at most about
+// kLanczosBasis + kLanczosRestarts (kLanczosBasis - 1) products with S.
+constexpr int kLanczosBasis = 40, kLanczosRestarts = 3;
+
 bool FindNegativeCurvature(const SESyncProblem& problem,
                            const Eigen::MatrixXd& Lambda,
                            VerificationResult* result) {
   CertificateOperator op(&problem, &Lambda);
   const int dim = static_cast<int>(op.rows());
   if (dim < 3) return false;
-  Spectra::SymEigsSolver<CertificateOperator> eigs(op, 1, std::min(40, dim));
+  Spectra::SymEigsSolver<CertificateOperator> eigs(
+      op, 1, std::min(kLanczosBasis, dim));
   eigs.init();
-  eigs.compute(Spectra::SortRule::SmallestAlge, /*maxit=*/3, /*tol=*/1e-3);
+  eigs.compute(Spectra::SortRule::SmallestAlge, kLanczosRestarts,
+               /*tol=*/1e-3);
   if (eigs.info() != Spectra::CompInfo::Successful) return false;
   const Eigen::VectorXd v = eigs.eigenvectors().col(0).normalized();
   const double curvature = v.dot(MultiplyCertificate(problem, Lambda, v));
@@ -159,6 +167,31 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     if (left > seconds && left > 0) return true;
     result.out_of_time = true;
     return false;
+  };
+  // Whether Lanczos on S (FindNegativeCurvature) is predicted to cost less
+  // than two double factorizations, the witness's other route (a proof
+  // above lambda_min, then shift-and-invert Lanczos on its factor). Its
+  // products with Q cost O(m r) but solve with Lbar, whose factor fills on
+  // 3D lattices: on a 97,336-pose cube one product took 43 ms, so the ~160
+  // of a Lanczos run that did not converge cost 6.9 s against 0.9 s per
+  // factorization. Unknown before a factorization has completed (Certify()
+  // of a poor guess: there Lanczos wins, cubicle's file guess 0.45 -> 0.19
+  // s, torus3D's 0.24 -> 0.13 s). One product is timed, once.
+  double product_seconds = -1;
+  auto lanczos_is_cheap = [&]() {
+    const double factorization = matrix->complete_double_seconds();
+    if (factorization <= 0) return true;
+    if (product_seconds < 0) {
+      const auto start = std::chrono::steady_clock::now();
+      MultiplyCertificate(problem, Lambda,
+                          Eigen::VectorXd::Ones(matrix->dimension()));
+      product_seconds = std::chrono::duration<double>(
+                            std::chrono::steady_clock::now() - start)
+                            .count();
+    }
+    const double products =
+        kLanczosBasis + kLanczosRestarts * (kLanczosBasis - 1);
+    return products * product_seconds < 2 * factorization;
   };
   double failed_double = 0;  // The largest shift a double proof failed at.
   auto prove = [&](double c, ProofPrecision precision) {
@@ -307,14 +340,16 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     } else {
       result.vacuous_bound = true;
       if (result.out_of_time) return finish();
-      if (fits(0) && FindNegativeCurvature(problem, Lambda, &result)) {
+      if (fits(0) && lanczos_is_cheap() &&
+          FindNegativeCurvature(problem, Lambda, &result)) {
         return finish();
       }
       c = c_vacuous;
     }
   }
   for (int step = 0; c < c_upper && !result.out_of_time; ++step) {
-    if (step == 2 && matrix->supernodal() && !result.vacuous_bound && fits(0)) {
+    if (step == 2 && matrix->supernodal() && !result.vacuous_bound && fits(0) &&
+        lanczos_is_cheap()) {
       // lambda_min(S) < -256 max(eta_target, eta_max): usually clear
       // negative curvature (a saddle or a poor candidate), which Lanczos on
       // S finds in a few dozen products with Q; jump the shift just past
@@ -359,11 +394,14 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     } else {
       LOG(WARNING) << "shift-and-invert Lanczos did not converge";
     }
-    // Tighten the shift to just above the estimate when that can certify.
+    // Tighten the shift to just above the estimate, unless the bound stays
+    // vacuous there too (a shift >= c_vacuous bounds F by at most 0).
     if (std::isfinite(result.lambda_min_estimate)) {
       const double tight =
           std::max(eta_target, -1.05 * result.lambda_min_estimate);
-      if (tight < factor_shift) prove(tight, ProofPrecision::kDouble);
+      if (tight < factor_shift && tight < c_vacuous) {
+        prove(tight, ProofPrecision::kDouble);
+      }
     }
   }
   // No clear negative curvature of S itself (the direction's Rayleigh
