@@ -16,25 +16,21 @@ struct OpenMpRuntime {
 // libgomp's ICV accessors if it is loaded (CHOLMOD depends on it);
 // RTLD_NOLOAD never loads it. Looked up once.
 const OpenMpRuntime& Runtime() {
-  static const OpenMpRuntime runtime = [] {
-    OpenMpRuntime r;
-    void* gomp = dlopen("libgomp.so.1", RTLD_LAZY | RTLD_NOLOAD);
-    if (gomp == nullptr) return r;
-    OpenMpRuntime found;
-    found.get_dynamic =
-        reinterpret_cast<int (*)()>(dlsym(gomp, "omp_get_dynamic"));
-    found.set_dynamic =
-        reinterpret_cast<void (*)(int)>(dlsym(gomp, "omp_set_dynamic"));
-    found.get_max_threads =
-        reinterpret_cast<int (*)()>(dlsym(gomp, "omp_get_max_threads"));
-    found.set_num_threads =
-        reinterpret_cast<void (*)(int)>(dlsym(gomp, "omp_set_num_threads"));
-    if (found.get_dynamic && found.set_dynamic && found.get_max_threads &&
-        found.set_num_threads) {
-      r = found;
-    }
+  static const OpenMpRuntime runtime = []() -> OpenMpRuntime {
     // The handle is kept: the library stays loaded while CHOLMOD is.
-    return r;
+    void* gomp = dlopen("libgomp.so.1", RTLD_LAZY | RTLD_NOLOAD);
+    if (gomp == nullptr) return {};
+    OpenMpRuntime r;
+    r.get_dynamic = reinterpret_cast<int (*)()>(dlsym(gomp, "omp_get_dynamic"));
+    r.set_dynamic =
+        reinterpret_cast<void (*)(int)>(dlsym(gomp, "omp_set_dynamic"));
+    r.get_max_threads =
+        reinterpret_cast<int (*)()>(dlsym(gomp, "omp_get_max_threads"));
+    r.set_num_threads =
+        reinterpret_cast<void (*)(int)>(dlsym(gomp, "omp_set_num_threads"));
+    const bool complete = r.get_dynamic && r.set_dynamic && r.get_max_threads &&
+                          r.set_num_threads;
+    return complete ? r : OpenMpRuntime{};
   }();
   return runtime;
 }

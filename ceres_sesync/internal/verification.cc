@@ -54,16 +54,18 @@ class CertificateOperator {
   const Eigen::MatrixXd* lambda_;
 };
 
+// FindNegativeCurvature's Lanczos: a basis of kLanczosBasis vectors and at
+// most kLanczosRestarts restarts, so at most about kLanczosMaxProducts
+// products with S.
+constexpr int kLanczosBasis = 40, kLanczosRestarts = 3;
+constexpr int kLanczosMaxProducts =
+    kLanczosBasis + kLanczosRestarts * (kLanczosBasis - 1);
+
 // Fast detection of clearly negative curvature: a short Lanczos run for the
 // smallest eigenvalue of S itself. Returns true, with result->direction a
 // unit vector v, result->direction_curvature = v^T S v < 0 and
 // result->lambda_min_estimate the same Rayleigh quotient (>= lambda_min(S)),
 // when it converged to a negative eigenvalue; else leaves *result alone.
-// FindNegativeCurvature's Lanczos: a basis of kLanczosBasis vectors and at
-// most kLanczosRestarts restarts, i.e. at most about
-// kLanczosBasis + kLanczosRestarts (kLanczosBasis - 1) products with S.
-constexpr int kLanczosBasis = 40, kLanczosRestarts = 3;
-
 bool FindNegativeCurvature(const SESyncProblem& problem,
                            const Eigen::MatrixXd& Lambda,
                            VerificationResult* result) {
@@ -189,9 +191,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
                             std::chrono::steady_clock::now() - start)
                             .count();
     }
-    const double products =
-        kLanczosBasis + kLanczosRestarts * (kLanczosBasis - 1);
-    return products * product_seconds < 2 * factorization;
+    return kLanczosMaxProducts * product_seconds < 2 * factorization;
   };
   double failed_double = 0;  // The largest shift a double proof failed at.
   auto prove = [&](double c, ProofPrecision precision) {
