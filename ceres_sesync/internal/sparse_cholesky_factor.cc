@@ -1,7 +1,10 @@
 #include "ceres_sesync/internal/sparse_cholesky_factor.h"
 
 #include <algorithm>
+#include <functional>
 #include <numeric>
+#include <set>
+#include <type_traits>
 #include <utility>
 
 #include "ceres_sesync/internal/parallel.h"
@@ -170,6 +173,7 @@ SparseCholeskyFactor::SparseCholeskyFactor(const cholmod_factor* factor,
   }
   first_.push_back(n_);
   if (converted != nullptr) cholmod_free_factor(&converted, common);
+  BuildSchedule();
 }
 
 void SparseCholeskyFactor::ConvertToSinglePrecision() {
@@ -182,28 +186,196 @@ int64_t SparseCholeskyFactor::memory_bytes() const {
   return static_cast<int64_t>(values_.size()) * sizeof(double) +
          static_cast<int64_t>(values_float_.size()) * sizeof(float) +
          static_cast<int64_t>(row_index_.size() + first_.size() + rows_.size() +
-                              permutation_.size()) *
-             sizeof(int);
+                              permutation_.size() + order_.size() +
+                              top_columns_.size()) *
+             sizeof(int) +
+         static_cast<int64_t>(value_begin_.size() + row_begin_.size()) *
+             sizeof(int64_t);
+}
+
+int64_t SparseCholeskyFactor::top_entries() const {
+  int64_t entries = 0;
+  for (int k = num_bins() > 0 ? bin_end_.back() : 0;
+       k < static_cast<int>(order_.size()); ++k) {
+    const int64_t c = first_[order_[k] + 1] - first_[order_[k]];
+    entries += c * (c + 1) / 2 + c * rows_[order_[k]];
+  }
+  return entries;
 }
 
 namespace {
 
-// One supernode of the solves on W (r x N, column j = the r-vector w_j):
-// columns j0 .. j0 + c - 1, `nb` rows `below`, values as documented in the
-// header. C is c when fixed at compile time (then the supernode's r x c
-// block of W is held in registers across its rows), else Eigen::Dynamic.
-// Forward, L Z = W^T: z_k = (w_k - sum_q L(k, q) z_q) / L(k, k) within the
-// supernode, then w_i -= sum_k L(i, k) z_k for every row i below. Returns
-// the values after the supernode's. `scratch` holds r doubles (the row sums
-// of a dynamic R, so that no supernode allocates).
+// Bins of the parallel solve (header). Two match the machines this library
+// is measured on; the schedule must not depend on the thread count.
+constexpr int kNumBins = 2;
+// Factors with fewer stored entries are solved unsplit: below the parallel
+// work threshold of ThreadsFor() a split only adds bookkeeping.
+constexpr int64_t kMinSplitEntries = 1 << 17;
+// A split is kept only if its critical path (top + heaviest bin, in stored
+// entries) is at most this fraction of the whole factor.
+constexpr double kMaxSplitCriticalPath = 0.8;
+// The search for the top stops after this many supernodes (each step costs
+// one pass over the frontier).
+constexpr size_t kMaxTopSupernodes = 4096;
+
+}  // namespace
+
+void SparseCholeskyFactor::BuildSchedule() {
+  const int num_supernodes = static_cast<int>(rows_.size());
+  value_begin_.resize(num_supernodes);
+  row_begin_.resize(num_supernodes);
+  std::vector<int64_t> weight(num_supernodes);
+  int64_t value_offset = 0, row_offset = 0;
+  for (int s = 0; s < num_supernodes; ++s) {
+    const int64_t c = first_[s + 1] - first_[s];
+    value_begin_[s] = value_offset;
+    row_begin_[s] = row_offset;
+    weight[s] = c * (c + 1) / 2 + c * rows_[s];
+    value_offset += weight[s];
+    row_offset += rows_[s];
+  }
+  // Unsplit: everything is top.
+  order_.resize(num_supernodes);
+  std::iota(order_.begin(), order_.end(), 0);
+  bin_end_.clear();
+  top_columns_.resize(n_);
+  std::iota(top_columns_.begin(), top_columns_.end(), 0);
+  if (stored_entries_ < kMinSplitEntries) return;
+
+  // The supernodal elimination tree: the parent of s holds the first row
+  // below s (the rows of a supernode are ascending and all beyond it, so
+  // parents follow their children in the supernode order).
+  std::vector<int> supernode_of(n_);
+  for (int s = 0; s < num_supernodes; ++s) {
+    std::fill(supernode_of.begin() + first_[s],
+              supernode_of.begin() + first_[s + 1], s);
+  }
+  std::vector<int> parent(num_supernodes, -1);
+  std::vector<int64_t> subtree = weight;
+  std::vector<int> child_count(num_supernodes + 1, 0);
+  for (int s = 0; s < num_supernodes; ++s) {
+    if (rows_[s] == 0) continue;
+    parent[s] = supernode_of[row_index_[row_begin_[s]]];
+    CHECK_GT(parent[s], s);
+    subtree[parent[s]] += subtree[s];
+    ++child_count[parent[s] + 1];
+  }
+  // Children in CSR form; the roots are the children of a virtual node.
+  std::partial_sum(child_count.begin(), child_count.end(), child_count.begin());
+  std::vector<int> children(num_supernodes), next(child_count);
+  std::vector<int> roots;
+  for (int s = 0; s < num_supernodes; ++s) {
+    if (parent[s] < 0) {
+      roots.push_back(s);
+    } else {
+      children[next[parent[s]]++] = s;
+    }
+  }
+
+  // Grow the top from the roots, always taking the heaviest subtree of the
+  // frontier into it, and keep the prefix of that sequence whose split has
+  // the shortest critical path: top + heaviest bin, the bins filled with the
+  // frontier subtrees heaviest first, each into the lightest bin.
+  const int64_t total = value_offset;
+  std::set<std::pair<int64_t, int>, std::greater<>> frontier;
+  for (int s : roots) frontier.emplace(subtree[s], s);
+  auto fill_bins = [&](int64_t* load, std::vector<int>* bin) {
+    std::fill(load, load + kNumBins, 0);
+    for (const auto& [w, s] : frontier) {
+      const int b =
+          static_cast<int>(std::min_element(load, load + kNumBins) - load);
+      load[b] += w;
+      if (bin != nullptr) (*bin)[s] = b;
+    }
+    return *std::max_element(load, load + kNumBins);
+  };
+  std::vector<int> taken;  // The top in the order it was grown.
+  int64_t top_weight = 0, best_path = total, load[kNumBins];
+  size_t best_size = 0;
+  while (!frontier.empty() && top_weight < best_path &&
+         taken.size() < kMaxTopSupernodes) {
+    const int64_t path = top_weight + fill_bins(load, nullptr);
+    if (path < best_path) {
+      best_path = path;
+      best_size = taken.size();
+    }
+    const int s = frontier.begin()->second;
+    frontier.erase(frontier.begin());
+    taken.push_back(s);
+    top_weight += weight[s];
+    for (int k = child_count[s]; k < child_count[s + 1]; ++k) {
+      frontier.emplace(subtree[children[k]], children[k]);
+    }
+  }
+  // Bin of every supernode (-1: top) for the best prefix.
+  std::vector<int> bin(num_supernodes, -2);
+  frontier.clear();
+  for (size_t k = 0; k < best_size; ++k) bin[taken[k]] = -1;
+  for (int s = 0; s < num_supernodes; ++s) {
+    const bool parent_in_top = parent[s] < 0 || bin[parent[s]] == -1;
+    if (bin[s] != -1 && parent_in_top) frontier.emplace(subtree[s], s);
+  }
+  const int64_t heaviest = fill_bins(load, &bin);
+  int64_t top_total = 0;
+  for (size_t k = 0; k < best_size; ++k) top_total += weight[taken[k]];
+  VLOG(2) << "solve schedule: top " << top_total << " of " << total
+          << " stored entries, heaviest bin " << heaviest
+          << (top_total + heaviest > kMaxSplitCriticalPath * total
+                  ? " (not split)"
+                  : "");
+  if (top_total + heaviest > kMaxSplitCriticalPath * total) return;
+  for (int s = num_supernodes - 1; s >= 0; --s) {
+    if (bin[s] == -2) bin[s] = bin[parent[s]];  // Parents come first here.
+  }
+
+  // The schedule, and the bins' row indices of top rows redirected to their
+  // accumulators.
+  order_.clear();
+  top_columns_.clear();
+  for (int b = 0; b < kNumBins; ++b) {
+    for (int s = 0; s < num_supernodes; ++s) {
+      if (bin[s] == b) order_.push_back(s);
+    }
+    bin_end_.push_back(static_cast<int>(order_.size()));
+  }
+  std::vector<int> slot(n_, -1);
+  for (int s = 0; s < num_supernodes; ++s) {
+    if (bin[s] != -1) continue;
+    order_.push_back(s);
+    for (int j = first_[s]; j < first_[s + 1]; ++j) {
+      slot[j] = static_cast<int>(top_columns_.size());
+      top_columns_.push_back(j);
+    }
+  }
+  const int num_top = static_cast<int>(top_columns_.size());
+  for (int s = 0; s < num_supernodes; ++s) {
+    if (bin[s] < 0) continue;
+    int* rows = row_index_.data() + row_begin_[s];
+    for (int i = 0; i < rows_[s]; ++i) {
+      const int b = bin[supernode_of[rows[i]]];
+      CHECK(b == bin[s] || b == -1) << "a bin's row in another bin";
+      if (b == -1) rows[i] = n_ + bin[s] * num_top + slot[rows[i]];
+    }
+  }
+}
+
+namespace {
+
+// One supernode of the solves on W (r rows, column j = the r-vector w_j at
+// w + j * ld): columns j0 .. j0 + c - 1, `nb` rows `below`, values as
+// documented in the header. C is c when fixed at compile time (then the
+// supernode's r x c block of W is held in registers across its rows), else
+// Eigen::Dynamic. Forward, L Z = W^T: z_k = (w_k - sum_q L(k, q) z_q) / L(k,
+// k) within the supernode, then w_i -= sum_k L(i, k) z_k for every row i
+// below. `scratch` holds r doubles (the row sums of a dynamic R, so that no
+// supernode allocates).
 template <typename Scalar, int R, int C>
-EIGEN_ALWAYS_INLINE const Scalar* ForwardSupernode(const Scalar* v,
-                                                   const int* below, int nb,
-                                                   int c, int r, int j0,
-                                                   double* w, double* scratch) {
+EIGEN_ALWAYS_INLINE void ForwardSupernode(const Scalar* v, const int* below,
+                                          int nb, int c, int r, int ld, int j0,
+                                          double* w, double* scratch) {
   using Map = Eigen::Map<Eigen::Matrix<double, R, 1>>;
   auto column = [&](int j) {
-    return Map(w + static_cast<std::ptrdiff_t>(j) * r, r);
+    return Map(w + static_cast<std::ptrdiff_t>(j) * ld, r);
   };
   for (int k = 0; k < c; ++k) {
     Map w_k = column(j0 + k);
@@ -215,15 +387,14 @@ EIGEN_ALWAYS_INLINE const Scalar* ForwardSupernode(const Scalar* v,
   }
   if constexpr (R != Eigen::Dynamic && C != Eigen::Dynamic) {
     const Eigen::Matrix<double, R, C> Z =
-        Eigen::Map<const Eigen::Matrix<double, R, C>>(
-            w + static_cast<std::ptrdiff_t>(j0) * r);
+        Eigen::Map<const Eigen::Matrix<double, R, C>, 0, Eigen::OuterStride<>>(
+            w + static_cast<std::ptrdiff_t>(j0) * ld, Eigen::OuterStride<>(ld));
     // The same operations in the same order as the generic loop below
     // (results must not depend on how the rows were split).
     if constexpr (C == 1) {
       for (int i = 0; i < nb; ++i) {
         column(below[i]) -= static_cast<double>(v[i]) * Z.col(0);
       }
-      v += nb;
     } else {
       for (int i = 0; i < nb; ++i, v += C) {
         Eigen::Matrix<double, R, 1> sum = static_cast<double>(v[0]) * Z.col(0);
@@ -249,7 +420,6 @@ EIGEN_ALWAYS_INLINE const Scalar* ForwardSupernode(const Scalar* v,
       rows(Eigen::Matrix<double, R, 1>());
     }
   }
-  return v;
 }
 
 // Backward, L^T X = Z, for the supernode whose values start at `v`: the rows
@@ -257,16 +427,16 @@ EIGEN_ALWAYS_INLINE const Scalar* ForwardSupernode(const Scalar* v,
 // is solved from its last column.
 template <typename Scalar, int R, int C>
 EIGEN_ALWAYS_INLINE void BackwardSupernode(const Scalar* v, const int* below,
-                                           int nb, int c, int r, int j0,
+                                           int nb, int c, int r, int ld, int j0,
                                            double* w) {
   using Map = Eigen::Map<Eigen::Matrix<double, R, 1>>;
   auto column = [&](int j) {
-    return Map(w + static_cast<std::ptrdiff_t>(j) * r, r);
+    return Map(w + static_cast<std::ptrdiff_t>(j) * ld, r);
   };
   const Scalar* rectangle = v + static_cast<std::ptrdiff_t>(c) * (c + 1) / 2;
   if constexpr (R != Eigen::Dynamic && C != Eigen::Dynamic) {
-    Eigen::Map<Eigen::Matrix<double, R, C>> block(
-        w + static_cast<std::ptrdiff_t>(j0) * r);
+    Eigen::Map<Eigen::Matrix<double, R, C>, 0, Eigen::OuterStride<>> block(
+        w + static_cast<std::ptrdiff_t>(j0) * ld, Eigen::OuterStride<>(ld));
     Eigen::Matrix<double, R, C> sum = block;
     for (int i = 0; i < nb; ++i, rectangle += C) {
       const Map w_i = column(below[i]);
@@ -296,61 +466,65 @@ EIGEN_ALWAYS_INLINE void BackwardSupernode(const Scalar* v, const int* below,
 }  // namespace
 
 template <typename Scalar, int R>
-void SparseCholeskyFactor::SolveInPlace(const Scalar* values, int r,
-                                        double* w) const {
+void SparseCholeskyFactor::Forward(const Scalar* values, int begin, int end,
+                                   int r, int ld, double* w) const {
   constexpr int kDynamic = Eigen::Dynamic;
-  const int num_supernodes = static_cast<int>(rows_.size());
-  const Scalar* v = values;
-  const int* below = row_index_.data();
-  using Vector = Eigen::Matrix<double, R, 1>;
-  using Map = Eigen::Map<Vector>;
-  auto column = [&](int j) {
-    return Map(w + static_cast<std::ptrdiff_t>(j) * r, r);
-  };
+  using Map = Eigen::Map<Eigen::Matrix<double, R, 1>>;
   // Row sums of a dynamic R (fixed sizes live in registers).
   Eigen::VectorXd scratch(R == kDynamic ? r : 0);
-  for (int s = 0; s < num_supernodes; ++s) {
+  for (int k = begin; k < end; ++k) {
+    const int s = order_[k];
     const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
+    const Scalar* v = values + value_begin_[s];
+    const int* below = row_index_.data() + row_begin_[s];
     if (c == 1) {  // The common case of sparse factors, kept tight.
-      Map w_j = column(j0);
+      Map w_j(w + static_cast<std::ptrdiff_t>(j0) * ld, r);
       w_j *= static_cast<double>(v[0]);
       for (int i = 0; i < nb; ++i) {
-        column(below[i]) -= static_cast<double>(v[1 + i]) * w_j;
+        Map(w + static_cast<std::ptrdiff_t>(below[i]) * ld, r) -=
+            static_cast<double>(v[1 + i]) * w_j;
       }
-      v += 1 + nb;
-      below += nb;
       continue;
     }
     switch (R == kDynamic ? 0 : c) {
       case 2:
-        v = ForwardSupernode<Scalar, R, 2>(v, below, nb, c, r, j0, w,
-                                           scratch.data());
+        ForwardSupernode<Scalar, R, 2>(v, below, nb, c, r, ld, j0, w,
+                                       scratch.data());
         break;
       case 3:
-        v = ForwardSupernode<Scalar, R, 3>(v, below, nb, c, r, j0, w,
-                                           scratch.data());
+        ForwardSupernode<Scalar, R, 3>(v, below, nb, c, r, ld, j0, w,
+                                       scratch.data());
         break;
       case 4:
-        v = ForwardSupernode<Scalar, R, 4>(v, below, nb, c, r, j0, w,
-                                           scratch.data());
+        ForwardSupernode<Scalar, R, 4>(v, below, nb, c, r, ld, j0, w,
+                                       scratch.data());
         break;
       default:
-        v = ForwardSupernode<Scalar, R, kDynamic>(v, below, nb, c, r, j0, w,
-                                                  scratch.data());
+        ForwardSupernode<Scalar, R, kDynamic>(v, below, nb, c, r, ld, j0, w,
+                                              scratch.data());
     }
-    below += nb;
   }
-  for (int s = num_supernodes - 1; s >= 0; --s) {
+}
+
+template <typename Scalar, int R>
+void SparseCholeskyFactor::Backward(const Scalar* values, int begin, int end,
+                                    int r, int ld, double* w) const {
+  constexpr int kDynamic = Eigen::Dynamic;
+  using Vector = Eigen::Matrix<double, R, 1>;
+  using Map = Eigen::Map<Vector>;
+  Eigen::VectorXd scratch(R == kDynamic ? r : 0);
+  for (int k = end - 1; k >= begin; --k) {
+    const int s = order_[k];
     const int j0 = first_[s], c = first_[s + 1] - j0, nb = rows_[s];
-    below -= nb;
-    v -= static_cast<std::ptrdiff_t>(nb) * c +
-         static_cast<std::ptrdiff_t>(c) * (c + 1) / 2;
+    const Scalar* v = values + value_begin_[s];
+    const int* below = row_index_.data() + row_begin_[s];
     if (c == 1) {
-      Map w_j = column(j0);
+      Map w_j(w + static_cast<std::ptrdiff_t>(j0) * ld, r);
       auto solve = [&](auto&& sum) {
         sum = w_j;
         for (int i = 0; i < nb; ++i) {
-          sum -= static_cast<double>(v[1 + i]) * column(below[i]);
+          sum -= static_cast<double>(v[1 + i]) *
+                 Map(w + static_cast<std::ptrdiff_t>(below[i]) * ld, r);
         }
         w_j = sum * static_cast<double>(v[0]);
       };
@@ -363,38 +537,56 @@ void SparseCholeskyFactor::SolveInPlace(const Scalar* values, int r,
     }
     switch (R == kDynamic ? 0 : c) {
       case 2:
-        BackwardSupernode<Scalar, R, 2>(v, below, nb, c, r, j0, w);
+        BackwardSupernode<Scalar, R, 2>(v, below, nb, c, r, ld, j0, w);
         break;
       case 3:
-        BackwardSupernode<Scalar, R, 3>(v, below, nb, c, r, j0, w);
+        BackwardSupernode<Scalar, R, 3>(v, below, nb, c, r, ld, j0, w);
         break;
       case 4:
-        BackwardSupernode<Scalar, R, 4>(v, below, nb, c, r, j0, w);
+        BackwardSupernode<Scalar, R, 4>(v, below, nb, c, r, ld, j0, w);
         break;
       default:
-        BackwardSupernode<Scalar, R, kDynamic>(v, below, nb, c, r, j0, w);
+        BackwardSupernode<Scalar, R, kDynamic>(v, below, nb, c, r, ld, j0, w);
     }
   }
 }
 
 template <typename Scalar>
-void SparseCholeskyFactor::SolvePermuted(const Scalar* values, int r,
-                                         double* w) const {
+void SparseCholeskyFactor::SolvePhase(bool forward, const Scalar* values,
+                                      int begin, int end, int r, int ld,
+                                      double* w) const {
+  auto run = [&](auto fixed_rows) {
+    constexpr int R = decltype(fixed_rows)::value;
+    if (forward) {
+      Forward<Scalar, R>(values, begin, end, r, ld, w);
+    } else {
+      Backward<Scalar, R>(values, begin, end, r, ld, w);
+    }
+  };
   switch (r) {
     case 1:
-      return SolveInPlace<Scalar, 1>(values, r, w);
+      return run(std::integral_constant<int, 1>());
     case 2:
-      return SolveInPlace<Scalar, 2>(values, r, w);
+      return run(std::integral_constant<int, 2>());
     case 3:
-      return SolveInPlace<Scalar, 3>(values, r, w);
+      return run(std::integral_constant<int, 3>());
     case 4:
-      return SolveInPlace<Scalar, 4>(values, r, w);
+      return run(std::integral_constant<int, 4>());
     case 5:
-      return SolveInPlace<Scalar, 5>(values, r, w);
+      return run(std::integral_constant<int, 5>());
     case 6:
-      return SolveInPlace<Scalar, 6>(values, r, w);
+      return run(std::integral_constant<int, 6>());
     default:
-      return SolveInPlace<Scalar, Eigen::Dynamic>(values, r, w);
+      return run(std::integral_constant<int, Eigen::Dynamic>());
+  }
+}
+
+void SparseCholeskyFactor::SolvePhase(bool forward, int begin, int end, int r,
+                                      int ld, double* w) const {
+  if (single_precision()) {
+    SolvePhase(forward, values_float_.data(), begin, end, r, ld, w);
+  } else {
+    SolvePhase(forward, values_.data(), begin, end, r, ld, w);
   }
 }
 
@@ -410,32 +602,95 @@ void SparseCholeskyFactor::SolveRowsTail(const Eigen::MatrixXd& B, int offset,
   CHECK_EQ(offset + B.cols(), n_);
   const int r = static_cast<int>(B.rows());
   X->resize(r, B.cols());
-  const double work = 4.0 * r * stored_entries_;
-  const int parts = std::min(r, ThreadsFor(num_threads, work));
-  // Each part solves its own rows in a private contiguous workspace:
-  // W = B P^T (with zero leading columns), solved, then X = W P.
-  ParallelParts(parts, [&](int part, int num_parts) {
-    const int row = PartBegin(r, part, num_parts);
-    const int rows = PartBegin(r, part + 1, num_parts) - row;
-    Eigen::MatrixXd W(rows, n_);
-    for (int k = 0; k < n_; ++k) {
-      const int source = permutation_[k] - offset;
-      if (source >= 0) {
-        W.col(k) = B.col(source).segment(row, rows);
-      } else {
-        W.col(k).setZero();
+  const int threads = ThreadsFor(num_threads, 4.0 * r * stored_entries_);
+  const int num_bins = static_cast<int>(bin_end_.size());
+  const int num_top = static_cast<int>(top_columns_.size());
+  // W = B P^T (with zero leading columns), then the bins' accumulators.
+  Eigen::MatrixXd W(r, n_ + num_bins * num_top);
+  for (int k = 0; k < n_; ++k) {
+    const int source = permutation_[k] - offset;
+    if (source >= 0) {
+      W.col(k) = B.col(source);
+    } else {
+      W.col(k).setZero();
+    }
+  }
+  W.rightCols(num_bins * num_top).setZero();
+  // Solves rows row .. row + rows - 1 of W over the supernodes order_[begin
+  // .. end - 1]. When W's rows are split, each part works on a contiguous
+  // copy of its rows of the columns the supernodes touch (for_each_column),
+  // so that no two threads write to the same cache line.
+  auto solve = [&](int begin, int end, bool forward, bool backward, int row,
+                   int rows, auto&& for_each_column) {
+    Eigen::MatrixXd part;
+    double* w = W.data() + row;
+    int ld = r;
+    if (rows < r) {
+      part.resize(rows, W.cols());  // Only the touched columns are set.
+      for_each_column(
+          [&](int j) { part.col(j) = W.col(j).segment(row, rows); });
+      w = part.data();
+      ld = rows;
+    }
+    if (forward) SolvePhase(/*forward=*/true, begin, end, rows, ld, w);
+    if (backward) SolvePhase(/*forward=*/false, begin, end, rows, ld, w);
+    if (rows < r) {
+      for_each_column(
+          [&](int j) { W.col(j).segment(row, rows) = part.col(j); });
+    }
+  };
+  // The bins as (bin, row part) tasks over the threads: tasks touch disjoint
+  // entries of W, and a row's arithmetic does not depend on the split.
+  auto bins = [&](bool forward) {
+    const int row_parts = std::clamp(threads / num_bins, 1, r);
+    const int tasks = num_bins * row_parts;
+    ParallelParts(std::min(threads, tasks), [&](int part, int parts) {
+      for (int task = part; task < tasks; task += parts) {
+        const int b = task / row_parts, p = task % row_parts;
+        const int begin = b == 0 ? 0 : bin_end_[b - 1], end = bin_end_[b];
+        const int row = PartBegin(r, p, row_parts);
+        solve(begin, end, forward, !forward, row,
+              PartBegin(r, p + 1, row_parts) - row, [&](auto&& f) {
+                for (int k = begin; k < end; ++k) {
+                  for (int j = first_[order_[k]]; j < first_[order_[k] + 1];
+                       ++j) {
+                    f(j);
+                  }
+                }
+                for (int t = 0; t < num_top; ++t) f(n_ + b * num_top + t);
+              });
+      }
+    });
+  };
+  if (num_bins > 0) {
+    bins(/*forward=*/true);
+    for (int t = 0; t < num_top; ++t) {
+      for (int b = 0; b < num_bins; ++b) {
+        W.col(top_columns_[t]) += W.col(n_ + b * num_top + t);
       }
     }
-    if (single_precision()) {
-      SolvePermuted(values_float_.data(), rows, W.data());
-    } else {
-      SolvePermuted(values_.data(), rows, W.data());
-    }
-    for (int k = 0; k < n_; ++k) {
-      const int target = permutation_[k] - offset;
-      if (target >= 0) X->col(target).segment(row, rows) = W.col(k);
-    }
+  }
+  const int top_begin = num_bins > 0 ? bin_end_.back() : 0;
+  const int top_end = static_cast<int>(order_.size());
+  ParallelParts(std::min(r, threads), [&](int part, int parts) {
+    const int row = PartBegin(r, part, parts);
+    solve(top_begin, top_end, true, true, row,
+          PartBegin(r, part + 1, parts) - row, [&](auto&& f) {
+            for (int j : top_columns_) f(j);
+          });
   });
+  if (num_bins > 0) {
+    for (int t = 0; t < num_top; ++t) {
+      for (int b = 0; b < num_bins; ++b) {
+        W.col(n_ + b * num_top + t) = W.col(top_columns_[t]);
+      }
+    }
+    bins(/*forward=*/false);
+  }
+  for (int k = 0; k < n_; ++k) {
+    const int target = permutation_[k] - offset;
+    if (target >= 0) X->col(target) = W.col(k);
+  }
 }
 
 }  // namespace ceres_sesync::internal

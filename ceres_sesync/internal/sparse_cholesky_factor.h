@@ -18,6 +18,22 @@
 // before the supernodes are formed, so nothing is stored that the solves do
 // not need: per entry 8 bytes plus 4/c bytes of index (12 before), or 4 plus
 // 4/c in single precision (ConvertToSinglePrecision()).
+//
+// Parallel solves. The r rows are independent solves, but splitting them over
+// threads makes every thread stream the whole factor (and gather from its
+// own W at random rows): with r = 3 on two threads each still pays almost a
+// whole one-thread solve. Instead the elimination tree of the supernodes is
+// cut once, at construction, into kNumBins = 2 "bins" of disjoint subtrees of
+// about equal weight and the "top" (their common ancestors, with nested
+// dissection the top separators). Forward, the bins are solved concurrently,
+// each adding its updates of top rows into an accumulator of its own (extra
+// columns of W, to which the bins' row indices of top rows point), the
+// accumulators are added to the top in bin order, and the top is solved with
+// its rows split over threads; backward in reverse, the top's solution copied
+// into the accumulators for the bins to read. The schedule depends only on
+// the factor, never on the thread count, so results are bitwise the same for
+// every thread count (they differ from an unsplit solve in round-off only:
+// the order in which updates of top rows are summed).
 
 #ifndef CERES_SESYNC_INTERNAL_SPARSE_CHOLESKY_FACTOR_H_
 #define CERES_SESYNC_INTERNAL_SPARSE_CHOLESKY_FACTOR_H_
@@ -62,14 +78,29 @@ class SparseCholeskyFactor {
   // supernodes, and bytes of the arrays the solves read.
   int64_t stored_entries() const { return stored_entries_; }
   int num_supernodes() const { return static_cast<int>(rows_.size()); }
+  // Bins of the parallel solve schedule (0: unsplit) and the stored entries
+  // of its top (all of them when unsplit).
+  int num_bins() const { return static_cast<int>(bin_end_.size()); }
+  int64_t top_entries() const;
   int64_t memory_bytes() const;
 
  private:
-  // W = W L^{-T} L^{-1} for W (r x size(), column-major), in place.
+  // The solve schedule (see the top of this file), built by the constructor.
+  void BuildSchedule();
+  // W = W L^{-1} (forward) or W = W L^{-T} (backward) restricted to the
+  // supernodes order_[begin .. end - 1], for the r rows of W starting at `w`
+  // (column j at w + j * ld).
   template <typename Scalar, int R>
-  void SolveInPlace(const Scalar* values, int r, double* w) const;
+  void Forward(const Scalar* values, int begin, int end, int r, int ld,
+               double* w) const;
+  template <typename Scalar, int R>
+  void Backward(const Scalar* values, int begin, int end, int r, int ld,
+                double* w) const;
   template <typename Scalar>
-  void SolvePermuted(const Scalar* values, int r, double* w) const;
+  void SolvePhase(bool forward, const Scalar* values, int begin, int end, int r,
+                  int ld, double* w) const;
+  void SolvePhase(bool forward, int begin, int end, int r, int ld,
+                  double* w) const;
 
   int n_ = 0;
   int64_t stored_entries_ = 0;
@@ -83,6 +114,14 @@ class SparseCholeskyFactor {
   std::vector<int> first_, rows_, row_index_;
   std::vector<double> values_;       // Double precision (the default) ...
   std::vector<float> values_float_;  // ... or single (then values_ is empty).
+  // Where supernode s's values and row indices start.
+  std::vector<int64_t> value_begin_, row_begin_;
+  // The schedule: every supernode once, bin 0's in ascending order, then bin
+  // 1's, ..., then the top's; bin b is order_[bin_end_[b - 1] ..
+  // bin_end_[b] - 1] (bin_end_[-1] = 0), the top the rest. Without a split,
+  // bin_end_ is empty and everything is top. In the bins' row indices, top
+  // row top_columns_[t] reads n_ + b * top_columns_.size() + t instead.
+  std::vector<int> order_, bin_end_, top_columns_;
 };
 
 }  // namespace ceres_sesync::internal
