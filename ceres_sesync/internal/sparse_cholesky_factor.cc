@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <functional>
 #include <numeric>
-#include <set>
 #include <type_traits>
 #include <utility>
 
 #include "ceres_sesync/internal/parallel.h"
+#include "ceres_sesync/internal/tree_split.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
@@ -214,9 +214,6 @@ constexpr int64_t kMinSplitEntries = 1 << 17;
 // A split is kept only if its critical path (top + heaviest bin, in stored
 // entries) is at most this fraction of the whole factor.
 constexpr double kMaxSplitCriticalPath = 0.8;
-// The search for the top stops after this many supernodes (each step costs
-// one pass over the frontier).
-constexpr size_t kMaxTopSupernodes = 4096;
 
 }  // namespace
 
@@ -224,14 +221,15 @@ void SparseCholeskyFactor::BuildSchedule() {
   const int num_supernodes = static_cast<int>(rows_.size());
   value_begin_.resize(num_supernodes);
   row_begin_.resize(num_supernodes);
-  std::vector<int64_t> weight(num_supernodes);
+  std::vector<double> weight(num_supernodes);
   int64_t value_offset = 0, row_offset = 0;
   for (int s = 0; s < num_supernodes; ++s) {
     const int64_t c = first_[s + 1] - first_[s];
     value_begin_[s] = value_offset;
     row_begin_[s] = row_offset;
-    weight[s] = c * (c + 1) / 2 + c * rows_[s];
-    value_offset += weight[s];
+    const int64_t entries = c * (c + 1) / 2 + c * rows_[s];
+    weight[s] = static_cast<double>(entries);
+    value_offset += entries;
     row_offset += rows_[s];
   }
   // Unsplit: everything is top.
@@ -251,82 +249,16 @@ void SparseCholeskyFactor::BuildSchedule() {
               supernode_of.begin() + first_[s + 1], s);
   }
   std::vector<int> parent(num_supernodes, -1);
-  std::vector<int64_t> subtree = weight;
-  std::vector<int> child_count(num_supernodes + 1, 0);
   for (int s = 0; s < num_supernodes; ++s) {
-    if (rows_[s] == 0) continue;
-    parent[s] = supernode_of[row_index_[row_begin_[s]]];
-    CHECK_GT(parent[s], s);
-    subtree[parent[s]] += subtree[s];
-    ++child_count[parent[s] + 1];
+    if (rows_[s] > 0) parent[s] = supernode_of[row_index_[row_begin_[s]]];
   }
-  // Children in CSR form; the roots are the children of a virtual node.
-  std::partial_sum(child_count.begin(), child_count.end(), child_count.begin());
-  std::vector<int> children(num_supernodes), next(child_count);
-  std::vector<int> roots;
-  for (int s = 0; s < num_supernodes; ++s) {
-    if (parent[s] < 0) {
-      roots.push_back(s);
-    } else {
-      children[next[parent[s]]++] = s;
-    }
-  }
-
-  // Grow the top from the roots, always taking the heaviest subtree of the
-  // frontier into it, and keep the prefix of that sequence whose split has
-  // the shortest critical path: top + heaviest bin, the bins filled with the
-  // frontier subtrees heaviest first, each into the lightest bin.
-  const int64_t total = value_offset;
-  std::set<std::pair<int64_t, int>, std::greater<>> frontier;
-  for (int s : roots) frontier.emplace(subtree[s], s);
-  auto fill_bins = [&](int64_t* load, std::vector<int>* bin) {
-    std::fill(load, load + kNumBins, 0);
-    for (const auto& [w, s] : frontier) {
-      const int b =
-          static_cast<int>(std::min_element(load, load + kNumBins) - load);
-      load[b] += w;
-      if (bin != nullptr) (*bin)[s] = b;
-    }
-    return *std::max_element(load, load + kNumBins);
-  };
-  std::vector<int> taken;  // The top in the order it was grown.
-  int64_t top_weight = 0, best_path = total, load[kNumBins];
-  size_t best_size = 0;
-  while (!frontier.empty() && top_weight < best_path &&
-         taken.size() < kMaxTopSupernodes) {
-    const int64_t path = top_weight + fill_bins(load, nullptr);
-    if (path < best_path) {
-      best_path = path;
-      best_size = taken.size();
-    }
-    const int s = frontier.begin()->second;
-    frontier.erase(frontier.begin());
-    taken.push_back(s);
-    top_weight += weight[s];
-    for (int k = child_count[s]; k < child_count[s + 1]; ++k) {
-      frontier.emplace(subtree[children[k]], children[k]);
-    }
-  }
-  // Bin of every supernode (-1: top) for the best prefix.
-  std::vector<int> bin(num_supernodes, -2);
-  frontier.clear();
-  for (size_t k = 0; k < best_size; ++k) bin[taken[k]] = -1;
-  for (int s = 0; s < num_supernodes; ++s) {
-    const bool parent_in_top = parent[s] < 0 || bin[parent[s]] == -1;
-    if (bin[s] != -1 && parent_in_top) frontier.emplace(subtree[s], s);
-  }
-  const int64_t heaviest = fill_bins(load, &bin);
-  int64_t top_total = 0;
-  for (size_t k = 0; k < best_size; ++k) top_total += weight[taken[k]];
-  VLOG(2) << "solve schedule: top " << top_total << " of " << total
-          << " stored entries, heaviest bin " << heaviest
-          << (top_total + heaviest > kMaxSplitCriticalPath * total
-                  ? " (not split)"
-                  : "");
-  if (top_total + heaviest > kMaxSplitCriticalPath * total) return;
-  for (int s = num_supernodes - 1; s >= 0; --s) {
-    if (bin[s] == -2) bin[s] = bin[parent[s]];  // Parents come first here.
-  }
+  const TreeSplit split =
+      SplitTree(parent, weight, kNumBins, kMaxSplitCriticalPath);
+  VLOG(2) << "solve schedule: top " << split.top_weight << " of "
+          << split.total_weight << " stored entries, heaviest bin "
+          << split.heaviest_bin << (split.bin.empty() ? " (not split)" : "");
+  if (split.bin.empty()) return;
+  const std::vector<int>& bin = split.bin;
 
   // The schedule, and the bins' row indices of top rows redirected to their
   // accumulators.
