@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -313,6 +314,74 @@ TEST(ExtendedCholesky, SupernodalMatchesReferenceAndItsBound) {
     EXPECT_LE(worst_ratio, 1.0) << c.name;
     EXPECT_GT(worst_ratio, 0.0) << c.name;  // The residual is not zero ...
     EXPECT_LT(max_rho, 1e-25 * max_a) << c.name;  // ... the bound is tiny.
+  }
+}
+
+// The parallel factorization (the elimination tree split into two bins of
+// subtrees and their top, extended_cholesky.h): the same pattern, values
+// within the reference's tolerance, the true residual within the bound, and
+// bitwise the same factor for every thread count; an indefinite matrix is
+// rejected whichever part of the tree holds the failing pivot.
+TEST(ExtendedCholesky, SplitFactorizationIsSoundAndThreadIndependent) {
+  for (const Case& c : Cases()) {
+    const Matrix& m = c.matrix;
+    DoubleDoubleCholesky::Options options;
+    options.min_split_flops = 0;
+    DoubleDoubleCholesky one(options), reference(Simplicial());
+    options.num_threads = 2;
+    DoubleDoubleCholesky two(options);
+    one.Analyze(m.n, m.start, m.row);
+    two.Analyze(m.n, m.start, m.row);
+    reference.Analyze(m.n, m.start, m.row);
+    // A random sparse matrix fills to one dense block: nothing to split.
+    const bool random = std::string(c.name).rfind("random", 0) == 0;
+    EXPECT_EQ(one.num_bins(), random ? 0 : 2) << c.name;
+    ASSERT_TRUE(one.Factorize(m.value)) << c.name;
+    ASSERT_TRUE(two.Factorize(m.value)) << c.name;
+    ASSERT_TRUE(reference.Factorize(m.value)) << c.name;
+    ASSERT_EQ(one.factor_row(), reference.factor_row());
+    int differences = 0;
+    for (size_t p = 0; p < one.factor_value().size(); ++p) {
+      const DoubleDouble& a = one.factor_value()[p];
+      const DoubleDouble& b = two.factor_value()[p];
+      differences += std::signbit(a.hi) != std::signbit(b.hi) ||
+                     std::signbit(a.lo) != std::signbit(b.lo) ||
+                     !(a.hi == b.hi) || !(a.lo == b.lo);
+    }
+    EXPECT_EQ(differences, 0) << c.name;
+    const std::vector<double> row_max = RowMax(reference);
+    double worst_difference = 0;
+    for (size_t p = 0; p < reference.factor_row().size(); ++p) {
+      const Quad d =
+          ToQuad(one.factor_value()[p]) - ToQuad(reference.factor_value()[p]);
+      worst_difference =
+          std::max(worst_difference, static_cast<double>(Abs(d)) /
+                                         row_max[reference.factor_row()[p]]);
+    }
+    EXPECT_LT(worst_difference, 1e-23) << c.name;
+    std::vector<double> rho;
+    two.RowBackwardErrorBounds(&rho);
+    const std::vector<double> residual = ResidualRowSums(two, m);
+    double worst_ratio = 0;
+    for (int i = 0; i < m.n; ++i) {
+      worst_ratio = std::max(worst_ratio, residual[i] / rho[i]);
+    }
+    EXPECT_LE(worst_ratio, 1.0) << c.name;
+    EXPECT_GT(worst_ratio, 0.0) << c.name;
+  }
+  // Indefinite: the Laplacian's null vector is constant, so every pivot
+  // region is affected; rejected with one and with two threads.
+  for (int threads : {1, 2}) {
+    DoubleDoubleCholesky::Options options;
+    options.min_split_flops = 0;
+    options.num_threads = threads;
+    DoubleDoubleCholesky chol(options);
+    const Matrix negative = GridLaplacian(30, 30, 1, -1e-18, 4);
+    chol.Analyze(negative.n, negative.start, negative.row);
+    ASSERT_EQ(chol.num_bins(), 2);
+    EXPECT_FALSE(chol.Factorize(negative.value)) << threads;
+    const Matrix positive = GridLaplacian(30, 30, 1, 1e-18, 4);
+    EXPECT_TRUE(chol.Factorize(positive.value)) << threads;
   }
 }
 

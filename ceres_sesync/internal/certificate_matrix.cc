@@ -285,7 +285,9 @@ void CertificateMatrix::InitializeDoubleDouble() {
       extended_index_[q] = slot;
     }
   }
-  extended_ = std::make_unique<DoubleDoubleCholesky>();
+  DoubleDoubleCholesky::Options options;
+  options.num_threads = problem_.num_threads();
+  extended_ = std::make_unique<DoubleDoubleCholesky>(options);
   extended_->Analyze(size, std::move(start), std::move(row));
 }
 

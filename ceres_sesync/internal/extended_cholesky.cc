@@ -7,6 +7,7 @@
 #include "ceres_sesync/internal/extended_cholesky.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 
@@ -14,6 +15,8 @@
 #include <immintrin.h>
 #endif
 
+#include "ceres_sesync/internal/parallel.h"
+#include "ceres_sesync/internal/tree_split.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
@@ -510,6 +513,31 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
     const long long nrows = count(first);
     super_value_start_.push_back(super_value_start_.back() + nrows * ncols);
   }
+  // The split for parallel factorization (tree_split.h), weighted by the
+  // work each supernode's factorization step does: left-looking, column j's
+  // update of its row at position p (diagonal 0) of its c rows costs c - p
+  // multiply-adds, done when the supernode holding that row is factored.
+  super_bin_.clear();
+  if (flops_ >= options_.min_split_flops) {
+    std::vector<double> work(num_super, 0.0);
+    for (int j = 0; j < n; ++j) {
+      const int c = count(j);
+      for (int p = 0; p < c; ++p) {
+        work[column_super_[factor_row_[factor_start_[j] + p]]] += c - p;
+      }
+    }
+    std::vector<int> super_parent(num_super, -1);
+    for (int s = 0; s < num_super; ++s) {
+      const int up = parent_[super_start_[s + 1] - 1];
+      if (up >= 0) super_parent[s] = column_super_[up];
+    }
+    const TreeSplit split = SplitTree(super_parent, work, /*num_bins=*/2,
+                                      /*max_critical_fraction=*/0.85);
+    VLOG(2) << "double-double factorization: top " << split.top_weight << " of "
+            << split.total_weight << " multiply-adds, heaviest bin "
+            << split.heaviest_bin << (split.bin.empty() ? " (not split)" : "");
+    super_bin_ = split.bin;
+  }
   // Where each input value goes: entry (k, i), k >= i, of A is in the column
   // of supernode s = column_super_[i], at the position of row k.
   value_destination_.assign(row_index_.size(), -1);
@@ -564,97 +592,147 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   }
   // Left-looking: supernode d, once factored, waits in the list of the
   // supernode holding its next row below the ones already applied
-  // (pointer[d]), which it updates when that one's turn comes.
-  std::vector<int> head(num_super, -1), next(num_super, -1);
-  std::vector<int> pointer(num_super, 0), position(n_, -1);
-  std::vector<int> relative;
-  std::vector<double> work_hi, work_lo;
+  // (pointer[d]), which it updates when that one's turn comes. With a split
+  // (super_bin_), each bin keeps lists of its own (a bin's supernodes
+  // update only their ancestors: in the bin or in the top), which are
+  // joined, in bin order, for the top's turn.
+  const int num_bins = super_bin_.empty() ? 0 : 2;
+  std::vector<std::vector<int>> heads(num_bins + 1,
+                                      std::vector<int>(num_super, -1));
+  std::vector<int> next(num_super, -1), pointer(num_super, 0);
   const bool has_deadline =
       deadline != std::chrono::steady_clock::time_point::max();
-  for (int s = 0; s < num_super; ++s) {
-    if (has_deadline && std::chrono::steady_clock::now() > deadline) {
-      timed_out_ = true;
-      return false;
-    }
-    const int first = super_start_[s], last = super_start_[s + 1];
-    const int ncols = last - first;
-    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
-    const int* rows = super_row_.data() + super_row_start_[s];
-    double* s_hi = super_hi.data() + super_value_start_[s];
-    double* s_lo = super_lo.data() + super_value_start_[s];
-    for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
-    for (int d = head[s]; d != -1;) {
-      const int d_next = next[d];
-      const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
-      const int* d_rows = super_row_.data() + super_row_start_[d];
-      const int p1 = pointer[d];
-      int p2 = p1;
-      while (p2 < d_nrows && d_rows[p2] < last) ++p2;
-      const int m = d_nrows - p1, n = p2 - p1;
-      const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
-      const double* d_lo = super_lo.data() + super_value_start_[d] + p1;
-      const int k = super_start_[d + 1] - super_start_[d];
-      // The target rows of d's rows p1.. are contiguous in s (positions
-      // increase with the rows): update s in place; otherwise gather the
-      // target entries, update, scatter.
-      const int r0 = position[d_rows[p1]];
-      if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
-        kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
-                        s_hi + r0 + static_cast<long long>(r0) * nrows,
-                        s_lo + r0 + static_cast<long long>(r0) * nrows, nrows,
-                        m, n, k});
-      } else {
-        relative.resize(m);
-        for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
-        const size_t size = static_cast<size_t>(m) * n;
-        if (work_hi.size() < size) {
-          work_hi.resize(size);
-          work_lo.resize(size);
-        }
-        for (int j = 0; j < n; ++j) {
-          const double* t_hi =
-              s_hi + static_cast<long long>(relative[j]) * nrows;
-          const double* t_lo =
-              s_lo + static_cast<long long>(relative[j]) * nrows;
-          double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
-          double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
-          // Zeros above the diagonal where the kernel computes unused
-          // entries (from the start of j's block of columns).
-          for (int i = j - j % kColumnBlock; i < j; ++i) w_hi[i] = w_lo[i] = 0;
-          for (int i = j; i < m; ++i) {
-            w_hi[i] = t_hi[relative[i]];
-            w_lo[i] = t_lo[relative[i]];
+  std::atomic<bool> stop(false), timed_out(false);
+  // Factors the supernodes s with super_bin_[s] == bin (all if unsplit) in
+  // increasing order, with the lists `head`. False if stopped or on a
+  // failed pivot (which stops the other bins too).
+  auto factor = [&](int bin, std::vector<int>* head_list) {
+    std::vector<int>& head = *head_list;
+    std::vector<int> position(n_, -1), relative;
+    std::vector<double> work_hi, work_lo;
+    for (int s = 0; s < num_super; ++s) {
+      if (num_bins > 0 && super_bin_[s] != bin) continue;
+      if (stop.load(std::memory_order_relaxed)) return false;
+      if (has_deadline && std::chrono::steady_clock::now() > deadline) {
+        timed_out = true;
+        stop = true;
+        return false;
+      }
+      const int first = super_start_[s], last = super_start_[s + 1];
+      const int ncols = last - first;
+      const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+      const int* rows = super_row_.data() + super_row_start_[s];
+      double* s_hi = super_hi.data() + super_value_start_[s];
+      double* s_lo = super_lo.data() + super_value_start_[s];
+      for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
+      for (int d = head[s]; d != -1;) {
+        const int d_next = next[d];
+        const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
+        const int* d_rows = super_row_.data() + super_row_start_[d];
+        const int p1 = pointer[d];
+        int p2 = p1;
+        while (p2 < d_nrows && d_rows[p2] < last) ++p2;
+        const int m = d_nrows - p1, n = p2 - p1;
+        const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
+        const double* d_lo = super_lo.data() + super_value_start_[d] + p1;
+        const int k = super_start_[d + 1] - super_start_[d];
+        // The target rows of d's rows p1.. are contiguous in s (positions
+        // increase with the rows): update s in place; otherwise gather the
+        // target entries, update, scatter.
+        const int r0 = position[d_rows[p1]];
+        if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
+          kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                          s_hi + r0 + static_cast<long long>(r0) * nrows,
+                          s_lo + r0 + static_cast<long long>(r0) * nrows, nrows,
+                          m, n, k});
+        } else {
+          relative.resize(m);
+          for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
+          const size_t size = static_cast<size_t>(m) * n;
+          if (work_hi.size() < size) {
+            work_hi.resize(size);
+            work_lo.resize(size);
+          }
+          for (int j = 0; j < n; ++j) {
+            const double* t_hi =
+                s_hi + static_cast<long long>(relative[j]) * nrows;
+            const double* t_lo =
+                s_lo + static_cast<long long>(relative[j]) * nrows;
+            double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+            double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+            // Zeros above the diagonal where the kernel computes unused
+            // entries (from the start of j's block of columns).
+            for (int i = j - j % kColumnBlock; i < j; ++i) {
+              w_hi[i] = w_lo[i] = 0;
+            }
+            for (int i = j; i < m; ++i) {
+              w_hi[i] = t_hi[relative[i]];
+              w_lo[i] = t_lo[relative[i]];
+            }
+          }
+          kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                          work_hi.data(), work_lo.data(), m, m, n, k});
+          for (int j = 0; j < n; ++j) {
+            double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
+            double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
+            const double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+            const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+            for (int i = j; i < m; ++i) {
+              t_hi[relative[i]] = w_hi[i];
+              t_lo[relative[i]] = w_lo[i];
+            }
           }
         }
-        kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
-                        work_hi.data(), work_lo.data(), m, m, n, k});
-        for (int j = 0; j < n; ++j) {
-          double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
-          double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
-          const double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
-          const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
-          for (int i = j; i < m; ++i) {
-            t_hi[relative[i]] = w_hi[i];
-            t_lo[relative[i]] = w_lo[i];
-          }
+        pointer[d] = p2;
+        if (p2 < d_nrows) {
+          const int target = column_super_[d_rows[p2]];
+          next[d] = head[target];
+          head[target] = d;
         }
+        d = d_next;
       }
-      pointer[d] = p2;
-      if (p2 < d_nrows) {
-        const int target = column_super_[d_rows[p2]];
-        next[d] = head[target];
-        head[target] = d;
+      if (!FactorSupernode(kernels, nrows, ncols, s_hi, s_lo)) {
+        stop = true;
+        return false;
       }
-      d = d_next;
+      pointer[s] = ncols;
+      if (ncols < nrows) {
+        const int target = column_super_[rows[ncols]];
+        next[s] = head[target];
+        head[target] = s;
+      }
     }
-    if (!FactorSupernode(kernels, nrows, ncols, s_hi, s_lo)) return false;
-    pointer[s] = ncols;
-    if (ncols < nrows) {
-      const int target = column_super_[rows[ncols]];
-      next[s] = head[target];
-      head[target] = s;
+    return true;
+  };
+  bool ok = true;
+  if (num_bins > 0) {
+    bool bin_ok[2] = {true, true};
+    ParallelParts(std::min(options_.num_threads, num_bins),
+                  [&](int part, int parts) {
+                    for (int b = part; b < num_bins; b += parts) {
+                      bin_ok[b] = factor(b, &heads[b]);
+                    }
+                  });
+    ok = bin_ok[0] && bin_ok[1];
+    // The top's lists: bin 0's, then bin 1's (all their supernodes that
+    // still wait wait for a top supernode).
+    std::vector<int>& top_head = heads[num_bins];
+    for (int s = num_super - 1; ok && s >= 0; --s) {
+      if (super_bin_[s] != -1) continue;
+      for (int b = num_bins - 1; b >= 0; --b) {
+        int d = heads[b][s];
+        if (d == -1) continue;
+        while (next[d] != -1) d = next[d];
+        next[d] = top_head[s];
+        top_head[s] = heads[b][s];
+      }
     }
+    ok = ok && factor(-1, &top_head);
+  } else {
+    ok = factor(0, &heads[0]);
   }
+  timed_out_ = timed_out;
+  if (!ok) return false;
   // L in compressed columns.
   for (int s = 0; s < num_super; ++s) {
     const int first = super_start_[s];

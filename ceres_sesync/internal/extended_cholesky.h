@@ -56,6 +56,15 @@ class DoubleDoubleCholesky {
     // Use the SIMD kernels when the CPU has AVX2 and FMA. The results are
     // bitwise identical either way (tests compare); false is for testing.
     bool vectorize = true;
+    // Threads of the supernodal factorization: large elimination trees are
+    // split (tree_split.h) into two bins of subtrees, factored concurrently,
+    // and their top. The split depends on the matrix only: the results are
+    // bitwise the same for every thread count.
+    int num_threads = 1;
+    // Factorizations of fewer multiply-adds (sum over columns of count^2 /
+    // 2) are not split: a few milliseconds, where threads cost more than
+    // they save. Tests lower it to split small matrices.
+    double min_split_flops = 4e6;
   };
 
   DoubleDoubleCholesky() : DoubleDoubleCholesky(Options()) {}
@@ -108,6 +117,8 @@ class DoubleDoubleCholesky {
   long long supernodal_entries() const {
     return super_value_start_.empty() ? 0 : super_value_start_.back();
   }
+  // After Analyze(): bins of the parallel factorization (0: not split).
+  int num_bins() const { return super_bin_.empty() ? 0 : 2; }
   // Whether Factorize() uses the SIMD kernels.
   bool vectorized() const { return vectorized_; }
 
@@ -134,7 +145,9 @@ class DoubleDoubleCholesky {
   // super_value_start_[s] in the dense blocks of FactorizeSupernodal().
   std::vector<int> super_start_, super_row_start_, super_row_;
   std::vector<long long> super_value_start_;
-  std::vector<int> column_super_;             // Supernode of each column.
+  std::vector<int> column_super_;  // Supernode of each column.
+  // Bin of each supernode (-1: top) of the parallel factorization, or empty.
+  std::vector<int> super_bin_;
   std::vector<long long> value_destination_;  // Input value -> block entry.
 };
 
