@@ -144,13 +144,31 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     return;
   }
   certificate_ = std::make_unique<CertificateMatrix>(*problem_);
-  preconditioner_ = std::make_unique<SESyncPreconditioner>(
-      *problem_, ToInternal(options.preconditioner),
-      options.regularized_cholesky_max_condition, certificate_.get());
-  cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
+  auto build = [this] {
+    preconditioner_ = std::make_unique<SESyncPreconditioner>(
+        *problem_, ToInternal(options_.preconditioner),
+        options_.regularized_cholesky_max_condition, certificate_.get());
+    cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
+  };
+  // The exact preconditioner's factorization, the longest step of this stage
+  // on large maps (10^5-pose city: ~2 s, single-threaded), does not depend
+  // on the initial point: with a second thread it runs while Initialize()
+  // computes the chordal one (which only reads the problem), and Initialize()
+  // waits for it (its time is counted there).
+  if (problem_->num_threads() > 1 &&
+      options.preconditioner == SolverOptions::Preconditioner::kRegularizedQ &&
+      options.initialization == SolverOptions::Initialization::kChordal) {
+    preconditioner_pending_ = std::async(std::launch::async, build);
+  } else {
+    build();
+  }
   SetScales();
   s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
   ok_ = true;
+}
+
+void Staircase::AwaitPreconditioner() {
+  if (preconditioner_pending_.valid()) preconditioner_pending_.get();
 }
 
 void Staircase::SetScales() {
@@ -161,6 +179,7 @@ void Staircase::SetScales() {
 }
 
 bool Staircase::Reweight(MeasurementWeights weights, Clock::time_point start) {
+  AwaitPreconditioner();
   CHECK(problem_ != nullptr) << "Reweight() needs a valid, non-trivial problem";
   start_ = start;
   const int m = static_cast<int>(graph_.measurements.size());
@@ -274,6 +293,7 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
     }
     Y->topRows(d) = R;
   }
+  AwaitPreconditioner();
   s.initialization_time_s =
       std::chrono::duration<double>(Clock::now() - t).count();
   return true;
@@ -359,6 +379,7 @@ ProofPolicy ToPolicy(SolverOptions::ProofArithmetic arithmetic) {
 
 VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
                                      double sdp_value) {
+  AwaitPreconditioner();
   const int d = d_, n = n_;
   const double eta_floor = options_.min_relative_eta * scale_;
   auto shift = [&](double relative_bound) {
@@ -426,6 +447,7 @@ bool Staircase::Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus) {
 }
 
 void Staircase::Run(Eigen::MatrixXd* Y) {
+  AwaitPreconditioner();
   SolverSummary& s = *summary_;
   for (int r = static_cast<int>(Y->rows());; ++r) {
     SolverSummary::Level level;
@@ -505,6 +527,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
 }
 
 Solution Staircase::Round(const Eigen::MatrixXd& Y) {
+  AwaitPreconditioner();
   SolverSummary& s = *summary_;
   Progress("round", static_cast<int>(Y.rows()));
   const auto t = Clock::now();
@@ -565,6 +588,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
 }
 
 void Staircase::Report(const Eigen::MatrixXd& Y, const Solution& solution) {
+  AwaitPreconditioner();
   SolverSummary& s = *summary_;
   s.objective =
       problem_->weights().empty()

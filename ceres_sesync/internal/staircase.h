@@ -38,6 +38,7 @@
 #define CERES_SESYNC_INTERNAL_STAIRCASE_H_
 
 #include <chrono>
+#include <future>
 #include <memory>
 
 #include "Eigen/Core"
@@ -118,7 +119,10 @@ class Staircase {
   void Report(const Eigen::MatrixXd& Y, const Solution& solution);
 
   const SESyncProblem& problem() const { return *problem_; }
-  SESyncCost& cost() { return *cost_; }
+  SESyncCost& cost() {
+    AwaitPreconditioner();
+    return *cost_;
+  }
   // The last level's verification (after Run()).
   const VerificationResult& verification() const { return verification_; }
   // F(Y) at the end of Run().
@@ -131,6 +135,9 @@ class Staircase {
                 double objective = 0, double gradient_norm = 0) const;
   // scale_ and zero_objective_ from the problem's current data.
   void SetScales();
+  // Waits for the preconditioner (and cost) built concurrently with
+  // Initialize() (see the constructor), if it is still being built.
+  void AwaitPreconditioner();
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
   // start + max_time_s, or time_point::max() for no limit.
@@ -156,6 +163,9 @@ class Staircase {
   std::unique_ptr<CertificateMatrix> certificate_;
   std::unique_ptr<SESyncPreconditioner> preconditioner_;
   std::unique_ptr<SESyncCost> cost_;
+  // Builds preconditioner_ and cost_ on another thread (declared after what
+  // it uses, so that it is joined before they are destroyed).
+  std::future<void> preconditioner_pending_;
   VerificationResult verification_;
   double sdp_value_ = 0;
   double lower_bound_ = 0;  // Proven at the last verification.
