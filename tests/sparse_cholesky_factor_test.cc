@@ -189,7 +189,9 @@ TEST(SparseCholeskyFactor, ThreadsGiveIdenticalResults) {
   factor.compute(A);
   ASSERT_EQ(factor.info(), Eigen::Success);
   const SparseCholeskyFactor solver = factor.ExtractFactor();
-  for (int r : {2, 5, 7}) {
+  // Threads engage (ThreadsFor: 4 r entries >= 1e7) for every r below.
+  EXPECT_GE(4.0 * 3 * solver.stored_entries(), 1e7);
+  for (int r : {3, 5, 7}) {
     const Eigen::MatrixXd B = Eigen::MatrixXd::Random(r, n - 10);
     Eigen::MatrixXd serial, parallel;
     solver.SolveRowsTail(B, 10, &serial, 1);
@@ -230,7 +232,7 @@ SparseMatrix GridSpd(int side) {
 // stable solve, in every layout and precision of the stored factor, for full
 // and tail solves, and bitwise the same results for every thread count.
 TEST(SparseCholeskyFactor, SplitSolvesAreAccurateAndThreadIndependent) {
-  const int side = 120, n = side * side;
+  const int side = 200, n = side * side;
   const SparseMatrix lower = GridSpd(side);
   const SparseMatrix A = lower.selfadjointView<Eigen::Lower>();
   for (CholmodLayout layout :
@@ -241,6 +243,8 @@ TEST(SparseCholeskyFactor, SplitSolvesAreAccurateAndThreadIndependent) {
     ASSERT_EQ(factor.info(), Eigen::Success);
     SparseCholeskyFactor solver = factor.ExtractFactor();
     ASSERT_EQ(solver.num_bins(), 2) << "layout " << static_cast<int>(layout);
+    // Large enough for threads at r >= 3 (ThreadsFor: 4 r entries >= 1e7).
+    EXPECT_GE(4.0 * 3 * solver.stored_entries(), 1e7);
     EXPECT_GT(solver.top_entries(), 0);
     EXPECT_LT(solver.top_entries(), solver.stored_entries() / 4);
     for (const bool single : {false, true}) {

@@ -24,10 +24,13 @@ inline int ResolveNumThreads(int num_threads) {
   return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 
-// Threads worth using for `work` floating-point operations: below ~1M
-// (about 0.3 ms) starting threads would cost more than it saves.
+// Threads worth using for `work` floating-point operations: below ~1e7
+// (about 1.5 ms) a second thread did not pay on the 2-core machine, where
+// starting and joining one costs ~50 us and its caches start cold (with 1e6:
+// MultiplyQ of city10000 1.0 -> 1.3 ms, the exact preconditioner of
+// ais2klinik 1.1 -> 1.2-1.6 ms with two threads).
 inline int ThreadsFor(int num_threads, double work) {
-  return work < 1e6 ? 1 : std::max(1, num_threads);
+  return work < 1e7 ? 1 : std::max(1, num_threads);
 }
 
 // Calls f(part, num_parts) for part = 0 .. num_parts - 1, part 0 on the

@@ -208,9 +208,10 @@ namespace {
 // Bins of the parallel solve (header). Two match the machines this library
 // is measured on; the schedule must not depend on the thread count.
 constexpr int kNumBins = 2;
-// Factors with fewer stored entries are solved unsplit: below the parallel
-// work threshold of ThreadsFor() a split only adds bookkeeping.
-constexpr int64_t kMinSplitEntries = 1 << 17;
+// Factors with fewer stored entries are solved unsplit: a solve with r rows
+// is ~4 r entries of work, below the parallel threshold of ThreadsFor() (1e7)
+// for every r <= 10 here, where a split only adds bookkeeping.
+constexpr int64_t kMinSplitEntries = 1 << 18;
 // A split is kept only if its critical path (top + heaviest bin, in stored
 // entries) is at most this fraction of the whole factor.
 constexpr double kMaxSplitCriticalPath = 0.8;
