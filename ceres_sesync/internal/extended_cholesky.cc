@@ -380,6 +380,10 @@ struct Kernels {
 // that is not positive or not safe.
 constexpr int kPanel = 32;
 
+// Supernodes of at least this many columns take their updates in column
+// ranges on several threads (the top separators of nested dissection).
+constexpr int kMinColumnSplit = 64;
+
 bool FactorSupernode(const Kernels& kernels, int nrows, int ncols, double* hi,
                      double* lo) {
   const int ld = nrows;
@@ -603,13 +607,80 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   const bool has_deadline =
       deadline != std::chrono::steady_clock::time_point::max();
   std::atomic<bool> stop(false), timed_out(false);
-  // Factors the supernodes s with super_bin_[s] == bin (all if unsplit) in
-  // increasing order, with the lists `head`. False if stopped or on a
-  // failed pivot (which stops the other bins too).
-  auto factor = [&](int bin, std::vector<int>* head_list) {
-    std::vector<int>& head = *head_list;
-    std::vector<int> position(n_, -1), relative;
+  // Scratch of one thread's updates.
+  struct Scratch {
+    std::vector<int> relative;
     std::vector<double> work_hi, work_lo;
+  };
+  // Subtracts from supernode s (values s_hi/s_lo, nrows rows, the positions
+  // of its rows in `position`) the products of supernode d's rows p1 .. p2 - 1
+  // (rows of s's columns) with d's rows p1 .. end. Every entry of s receives
+  // the same operations in the same order whatever the range [p1, p2) it is
+  // updated in: splitting one update into column ranges changes nothing.
+  auto update = [&](int d, int p1, int p2, const std::vector<int>& position,
+                    double* s_hi, double* s_lo, int nrows, Scratch* scratch) {
+    const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
+    const int* d_rows = super_row_.data() + super_row_start_[d];
+    const int m = d_nrows - p1, n = p2 - p1;
+    const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
+    const double* d_lo = super_lo.data() + super_value_start_[d] + p1;
+    const int k = super_start_[d + 1] - super_start_[d];
+    // The target rows of d's rows p1.. are contiguous in s (positions
+    // increase with the rows): update s in place; otherwise gather the
+    // target entries, update, scatter.
+    const int r0 = position[d_rows[p1]];
+    if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
+      kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
+                      s_hi + r0 + static_cast<long long>(r0) * nrows,
+                      s_lo + r0 + static_cast<long long>(r0) * nrows, nrows, m,
+                      n, k});
+      return;
+    }
+    std::vector<int>& relative = scratch->relative;
+    std::vector<double>& work_hi = scratch->work_hi;
+    std::vector<double>& work_lo = scratch->work_lo;
+    relative.resize(m);
+    for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
+    const size_t size = static_cast<size_t>(m) * n;
+    if (work_hi.size() < size) {
+      work_hi.resize(size);
+      work_lo.resize(size);
+    }
+    for (int j = 0; j < n; ++j) {
+      const double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
+      const double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
+      double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+      double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+      // Zeros above the diagonal where the kernel computes unused entries
+      // (from the start of j's block of columns).
+      for (int i = j - j % kColumnBlock; i < j; ++i) w_hi[i] = w_lo[i] = 0;
+      for (int i = j; i < m; ++i) {
+        w_hi[i] = t_hi[relative[i]];
+        w_lo[i] = t_lo[relative[i]];
+      }
+    }
+    kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows, work_hi.data(),
+                    work_lo.data(), m, m, n, k});
+    for (int j = 0; j < n; ++j) {
+      double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
+      double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
+      const double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
+      const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+      for (int i = j; i < m; ++i) {
+        t_hi[relative[i]] = w_hi[i];
+        t_lo[relative[i]] = w_lo[i];
+      }
+    }
+  };
+  // Factors the supernodes s with super_bin_[s] == bin (all if unsplit) in
+  // increasing order, with the lists `head`, on `threads` threads: wide
+  // supernodes (the top separators, which receive most updates) take their
+  // updates in column ranges, one per thread. False if stopped or on a
+  // failed pivot (which stops the other bins too).
+  auto factor = [&](int bin, std::vector<int>* head_list, int threads) {
+    std::vector<int>& head = *head_list;
+    std::vector<int> position(n_, -1), list;
+    std::vector<Scratch> scratch(threads);
     for (int s = 0; s < num_super; ++s) {
       if (num_bins > 0 && super_bin_[s] != bin) continue;
       if (stop.load(std::memory_order_relaxed)) return false;
@@ -625,71 +696,55 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       double* s_hi = super_hi.data() + super_value_start_[s];
       double* s_lo = super_lo.data() + super_value_start_[s];
       for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
-      for (int d = head[s]; d != -1;) {
-        const int d_next = next[d];
+      // The updates: supernode d's rows p1 = pointer[d] .. p2 - 1 are in
+      // s's columns.
+      list.clear();
+      for (int d = head[s]; d != -1; d = next[d]) list.push_back(d);
+      auto rows_in_s = [&](int d) {
         const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
         const int* d_rows = super_row_.data() + super_row_start_[d];
-        const int p1 = pointer[d];
-        int p2 = p1;
+        int p2 = pointer[d];
         while (p2 < d_nrows && d_rows[p2] < last) ++p2;
-        const int m = d_nrows - p1, n = p2 - p1;
-        const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
-        const double* d_lo = super_lo.data() + super_value_start_[d] + p1;
-        const int k = super_start_[d + 1] - super_start_[d];
-        // The target rows of d's rows p1.. are contiguous in s (positions
-        // increase with the rows): update s in place; otherwise gather the
-        // target entries, update, scatter.
-        const int r0 = position[d_rows[p1]];
-        if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
-          kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
-                          s_hi + r0 + static_cast<long long>(r0) * nrows,
-                          s_lo + r0 + static_cast<long long>(r0) * nrows, nrows,
-                          m, n, k});
-        } else {
-          relative.resize(m);
-          for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
-          const size_t size = static_cast<size_t>(m) * n;
-          if (work_hi.size() < size) {
-            work_hi.resize(size);
-            work_lo.resize(size);
-          }
-          for (int j = 0; j < n; ++j) {
-            const double* t_hi =
-                s_hi + static_cast<long long>(relative[j]) * nrows;
-            const double* t_lo =
-                s_lo + static_cast<long long>(relative[j]) * nrows;
-            double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
-            double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
-            // Zeros above the diagonal where the kernel computes unused
-            // entries (from the start of j's block of columns).
-            for (int i = j - j % kColumnBlock; i < j; ++i) {
-              w_hi[i] = w_lo[i] = 0;
-            }
-            for (int i = j; i < m; ++i) {
-              w_hi[i] = t_hi[relative[i]];
-              w_lo[i] = t_lo[relative[i]];
-            }
-          }
-          kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
-                          work_hi.data(), work_lo.data(), m, m, n, k});
-          for (int j = 0; j < n; ++j) {
-            double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
-            double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
-            const double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
-            const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
-            for (int i = j; i < m; ++i) {
-              t_hi[relative[i]] = w_hi[i];
-              t_lo[relative[i]] = w_lo[i];
-            }
+        return p2;
+      };
+      const int parts = ncols >= kMinColumnSplit ? threads : 1;
+      ParallelParts(parts, [&](int part, int num_parts) {
+        // Columns first + c0 .. first + c1 - 1, about equal shares of the
+        // lower trapezoid (column j has nrows - j entries).
+        auto column_begin = [&](int q) {
+          if (q == num_parts) return ncols;
+          const double area = (2.0 * nrows - ncols) * ncols * q / num_parts;
+          // Largest c with c (2 nrows - c) <= area.
+          const double c =
+              nrows - std::sqrt(std::max(
+                          0.0, static_cast<double>(nrows) * nrows - area));
+          return std::clamp(static_cast<int>(c), 0, ncols);
+        };
+        const int c0 = column_begin(part), c1 = column_begin(part + 1);
+        for (int d : list) {
+          const int* d_rows = super_row_.data() + super_row_start_[d];
+          const int p1 = pointer[d], p2 = rows_in_s(d);
+          const int q1 =
+              std::lower_bound(d_rows + p1, d_rows + p2, first + c0) - d_rows;
+          const int q2 =
+              std::lower_bound(d_rows + q1, d_rows + p2, first + c1) - d_rows;
+          if (q1 < q2) {
+            update(d, q1, q2, position, s_hi, s_lo, nrows, &scratch[part]);
           }
         }
+      });
+      // Each d waits next for the supernode of its first row beyond s.
+      head[s] = -1;
+      for (int d : list) {
+        const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
+        const int* d_rows = super_row_.data() + super_row_start_[d];
+        const int p2 = rows_in_s(d);
         pointer[d] = p2;
         if (p2 < d_nrows) {
           const int target = column_super_[d_rows[p2]];
           next[d] = head[target];
           head[target] = d;
         }
-        d = d_next;
       }
       if (!FactorSupernode(kernels, nrows, ncols, s_hi, s_lo)) {
         stop = true;
@@ -710,7 +765,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     ParallelParts(std::min(options_.num_threads, num_bins),
                   [&](int part, int parts) {
                     for (int b = part; b < num_bins; b += parts) {
-                      bin_ok[b] = factor(b, &heads[b]);
+                      bin_ok[b] = factor(b, &heads[b], 1);
                     }
                   });
     ok = bin_ok[0] && bin_ok[1];
@@ -727,9 +782,9 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
         top_head[s] = heads[b][s];
       }
     }
-    ok = ok && factor(-1, &top_head);
+    ok = ok && factor(-1, &top_head, options_.num_threads);
   } else {
-    ok = factor(0, &heads[0]);
+    ok = factor(0, &heads[0], options_.num_threads);
   }
   timed_out_ = timed_out;
   if (!ok) return false;
