@@ -465,7 +465,11 @@ void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
     flops_ += 0.5 * count[k] * static_cast<double>(count[k]);
   }
   factor_row_.resize(factor_start_[n]);
-  factor_value_.resize(factor_start_[n]);
+  // The supernodal factorization keeps L in its dense blocks instead.
+  factor_value_.assign(options_.supernodal ? 0 : factor_start_[n],
+                       DoubleDouble());
+  super_hi_.clear();
+  super_lo_.clear();
   factorized_ = false;
   super_start_.clear();
   super_row_start_.clear();
@@ -585,9 +589,14 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   const int num_super = num_supernodes();
   const Kernels kernels = vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2}
                                       : Kernels{UpdatePortable, ScalePortable};
-  // The dense blocks (only for the factorization: L is copied out).
-  std::vector<double> super_hi(supernodal_entries(), 0.0);
-  std::vector<double> super_lo(supernodal_entries(), 0.0);
+  // The dense blocks, kept as the factor (allocated once per analysis: on
+  // the virtual machines measured, first touching fresh pages cost more than
+  // this whole loop).
+  factor_value_.clear();
+  std::vector<double>& super_hi = super_hi_;
+  std::vector<double>& super_lo = super_lo_;
+  super_hi.assign(supernodal_entries(), 0.0);
+  super_lo.assign(supernodal_entries(), 0.0);
   for (size_t p = 0; p < values.size(); ++p) {
     // Renormalized (the same value): the kernels' bounds assume it.
     const DoubleDouble v = dd::TwoSum(values[p].hi, values[p].lo);
@@ -788,21 +797,6 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   }
   timed_out_ = timed_out;
   if (!ok) return false;
-  // L in compressed columns.
-  for (int s = 0; s < num_super; ++s) {
-    const int first = super_start_[s];
-    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
-    const double* s_hi = super_hi.data() + super_value_start_[s];
-    const double* s_lo = super_lo.data() + super_value_start_[s];
-    for (int j = first; j < super_start_[s + 1]; ++j) {
-      const long long offset =
-          static_cast<long long>(j - first) * nrows + (j - first);
-      for (int p = factor_start_[j]; p < factor_start_[j + 1]; ++p) {
-        const long long t = offset + (p - factor_start_[j]);
-        factor_value_[p] = DoubleDouble(s_hi[t], s_lo[t]);
-      }
-    }
-  }
   return true;
 }
 
@@ -836,14 +830,14 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
   // 10^9 terms (gamma_{10^9} < 1.2e-7).
   std::vector<double> column_sum(n_, 0.0), v(n_, 0.0);
   for (int c = 0; c < n_; ++c) {
-    for (int p = factor_start_[c]; p < factor_start_[c + 1]; ++p) {
-      column_sum[c] += factor_value_[p].AbsUpperBound();
-    }
+    ForEachEntry(c, [&](int, const DoubleDouble& l) {
+      column_sum[c] += l.AbsUpperBound();
+    });
   }
   for (int c = 0; c < n_; ++c) {
-    for (int p = factor_start_[c]; p < factor_start_[c + 1]; ++p) {
-      v[factor_row_[p]] += factor_value_[p].AbsUpperBound() * column_sum[c];
-    }
+    ForEachEntry(c, [&](int row, const DoubleDouble& l) {
+      v[row] += l.AbsUpperBound() * column_sum[c];
+    });
   }
   // Underflow: every entry is computed with at most max_count + 2
   // operations, each erring by at most kUnderflowError absolutely, scaled by
@@ -853,8 +847,7 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
   double max_pivot = 1;
   for (int c = 0; c < n_; ++c) {
     max_count = std::max(max_count, row_count_[c]);
-    max_pivot =
-        std::max(max_pivot, factor_value_[factor_start_[c]].AbsUpperBound());
+    max_pivot = std::max(max_pivot, Entry(c, 0).AbsUpperBound());
   }
   const double underflow_per_entry =
       (max_count + 2.0) * kUnderflowError * max_pivot * (1 + 1e-6);
@@ -865,6 +858,27 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
     (*rho)[i] = DoubleDoubleGamma(row_count_[i] + 1) * v[i] * (1 + 1e-6) +
                 entries * underflow_per_entry;
   }
+}
+
+DoubleDouble DoubleDoubleCholesky::Entry(int c, int t) const {
+  if (!options_.supernodal) return factor_value_[factor_start_[c] + t];
+  const int s = column_super_[c], jj = c - super_start_[s];
+  const long long nrows = super_row_start_[s + 1] - super_row_start_[s];
+  const long long at = super_value_start_[s] + jj * nrows + jj + t;
+  return DoubleDouble(super_hi_[at], super_lo_[at]);
+}
+
+const std::vector<DoubleDouble>& DoubleDoubleCholesky::factor_value() const {
+  if (options_.supernodal && factorized_ && factor_value_.empty()) {
+    factor_value_.resize(factor_start_[n_]);
+    for (int c = 0; c < n_; ++c) {
+      int t = 0;
+      ForEachEntry(c, [&](int, const DoubleDouble& l) {
+        factor_value_[factor_start_[c] + t++] = l;
+      });
+    }
+  }
+  return factor_value_;
 }
 
 }  // namespace ceres_sesync::internal

@@ -98,12 +98,12 @@ class DoubleDoubleCholesky {
     return factor_start_.empty() ? 0 : factor_start_.back();
   }
   // After a successful Factorize(): L in compressed columns (each column's
-  // diagonal first, then its rows in increasing order).
+  // diagonal first, then its rows in increasing order). The supernodal
+  // scheme keeps L in its dense blocks: factor_value() copies it out on its
+  // first call after a factorization (for inspection and tests).
   const std::vector<int>& factor_start() const { return factor_start_; }
   const std::vector<int>& factor_row() const { return factor_row_; }
-  const std::vector<DoubleDouble>& factor_value() const {
-    return factor_value_;
-  }
+  const std::vector<DoubleDouble>& factor_value() const;
   // Multiply-adds of one factorization: sum over columns of count^2 / 2.
   double flops() const { return flops_; }
   // After Analyze(), supernodal: the supernodes and their stored entries
@@ -124,6 +124,15 @@ class DoubleDoubleCholesky {
 
  private:
   void AnalyzeSupernodes();
+  // Entry t (0: the diagonal) of column c of L, in either layout, and f(row,
+  // value) for every entry of column c in order.
+  DoubleDouble Entry(int c, int t) const;
+  template <typename F>
+  void ForEachEntry(int c, F&& f) const {
+    for (int p = factor_start_[c]; p < factor_start_[c + 1]; ++p) {
+      f(factor_row_[p], Entry(c, p - factor_start_[c]));
+    }
+  }
   bool FactorizeSupernodal(const std::vector<DoubleDouble>& values,
                            std::chrono::steady_clock::time_point deadline);
 
@@ -134,8 +143,13 @@ class DoubleDoubleCholesky {
   std::vector<int> parent_;                    // Elimination tree.
   std::vector<int> factor_start_;              // Column pointers of L.
   std::vector<int> factor_row_;                // Row indices of L.
-  std::vector<DoubleDouble> factor_value_;     // Values of L.
-  std::vector<int> row_count_;                 // Entries per row of L.
+  // Values of L (simplicial; for the supernodal scheme a copy made by
+  // factor_value() on demand).
+  mutable std::vector<DoubleDouble> factor_value_;
+  // The supernodal scheme's dense blocks (see super_value_start_), which
+  // hold L after a successful factorization.
+  std::vector<double> super_hi_, super_lo_;
+  std::vector<int> row_count_;  // Entries per row of L.
   double flops_ = 0;
   bool factorized_ = false;
   bool timed_out_ = false;
