@@ -86,8 +86,8 @@ struct CertifyOptions {
   double goal_relative_suboptimality = 1e-6;
   SolverOptions::ProofArithmetic proof_arithmetic =
       SolverOptions::ProofArithmetic::kAutomatic;
-  // Threads for the products with Q (<= 0: all cores); see
-  // SolverOptions::num_threads.
+  // Threads for the products with Q, the solves and the double-double proof
+  // (<= 0: all cores); see SolverOptions::num_threads.
   int num_threads = 0;
 };
 

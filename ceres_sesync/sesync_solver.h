@@ -148,11 +148,13 @@ struct SolverOptions {
   // lowers F(x) (and the suboptimality bound).
   bool refine_rounded_solution = true;
 
-  // Threads for the O(m r) kernels (products with Q, the preconditioner's
-  // triangular solves, one thread per row block of Y). <= 0: all cores
-  // (std::thread::hardware_concurrency()). Results do not depend on it. Needs
-  // a build with OpenMP (else serial); the sparse factorizations themselves
-  // (CHOLMOD) are serial in the Debian build.
+  // Threads for the products with Q, the triangular solves (two subtrees of
+  // the factor's elimination tree at a time), the double-double proof's
+  // factorization (likewise, plus column ranges of its top separators), and
+  // the exact preconditioner's factorization, which runs beside the chordal
+  // initialization. Kernels under ~1.5 ms of work stay on one thread. <= 0:
+  // all cores (std::thread::hardware_concurrency()). Results are bitwise the
+  // same for every value. CHOLMOD's own factorizations are serial.
   int num_threads = 0;
 
   // Wall-clock limit for the whole solve (<= 0: none).
