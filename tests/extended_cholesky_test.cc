@@ -238,6 +238,22 @@ std::vector<double> RowMax(const DoubleDoubleCholesky& chol) {
   return m;
 }
 
+// Entries of two factors of the same pattern that differ in any bit (signed
+// zeros included).
+int BitwiseDifferences(const DoubleDoubleCholesky& x,
+                       const DoubleDoubleCholesky& y) {
+  EXPECT_EQ(x.factor_value().size(), y.factor_value().size());
+  int differences = 0;
+  for (size_t p = 0; p < x.factor_value().size(); ++p) {
+    const DoubleDouble& a = x.factor_value()[p];
+    const DoubleDouble& b = y.factor_value()[p];
+    differences += std::signbit(a.hi) != std::signbit(b.hi) ||
+                   std::signbit(a.lo) != std::signbit(b.lo) ||
+                   !(a.hi == b.hi) || !(a.lo == b.lo);
+  }
+  return differences;
+}
+
 struct Case {
   const char* name;
   Matrix matrix;
@@ -340,15 +356,7 @@ TEST(ExtendedCholesky, SplitFactorizationIsSoundAndThreadIndependent) {
     ASSERT_TRUE(two.Factorize(m.value)) << c.name;
     ASSERT_TRUE(reference.Factorize(m.value)) << c.name;
     ASSERT_EQ(one.factor_row(), reference.factor_row());
-    int differences = 0;
-    for (size_t p = 0; p < one.factor_value().size(); ++p) {
-      const DoubleDouble& a = one.factor_value()[p];
-      const DoubleDouble& b = two.factor_value()[p];
-      differences += std::signbit(a.hi) != std::signbit(b.hi) ||
-                     std::signbit(a.lo) != std::signbit(b.lo) ||
-                     !(a.hi == b.hi) || !(a.lo == b.lo);
-    }
-    EXPECT_EQ(differences, 0) << c.name;
+    EXPECT_EQ(BitwiseDifferences(one, two), 0) << c.name;
     const std::vector<double> row_max = RowMax(reference);
     double worst_difference = 0;
     for (size_t p = 0; p < reference.factor_row().size(); ++p) {
@@ -399,16 +407,7 @@ TEST(ExtendedCholesky, SimdAndPortableKernelsAgreeBitwise) {
     if (!simd.vectorized()) {
       std::printf("no AVX2+FMA: both portable\n");
     }
-    int differences = 0;
-    for (size_t p = 0; p < simd.factor_value().size(); ++p) {
-      const DoubleDouble& a = simd.factor_value()[p];
-      const DoubleDouble& b = portable.factor_value()[p];
-      // Bitwise (signed zeros included).
-      differences += std::signbit(a.hi) != std::signbit(b.hi) ||
-                     std::signbit(a.lo) != std::signbit(b.lo) ||
-                     !(a.hi == b.hi) || !(a.lo == b.lo);
-    }
-    EXPECT_EQ(differences, 0) << c.name;
+    EXPECT_EQ(BitwiseDifferences(simd, portable), 0) << c.name;
   }
 }
 

@@ -15,27 +15,41 @@
 namespace ceres_sesync::internal {
 namespace {
 
+// The lower triangle of a weighted graph Laplacian plus shift * I: SPD and
+// diagonally dominant. Calls add_edges(edge) with edge(i, j, w) adding the
+// edge {i, j} of weight w > 0 (loops i == j are ignored; duplicates sum).
+template <typename AddEdges>
+SparseMatrix ShiftedLaplacian(int n, double shift, AddEdges&& add_edges) {
+  std::vector<Eigen::Triplet<double>> t;
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(n, shift);
+  add_edges([&](int i, int j, double w) {
+    if (i == j) return;
+    t.emplace_back(std::max(i, j), std::min(i, j), -w);
+    diagonal(i) += w;
+    diagonal(j) += w;
+  });
+  for (int i = 0; i < n; ++i) t.emplace_back(i, i, diagonal(i));
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+
 // A random sparse SPD matrix: a ring plus random chords (fill after
 // reordering), diagonally dominant so it is well conditioned.
 SparseMatrix RandomSpd(int n, int extra_edges, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> weight(0.1, 2.0);
   std::uniform_int_distribution<int> vertex(0, n - 1);
-  std::vector<Eigen::Triplet<double>> t;
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(n, 0.5);
-  auto edge = [&](int i, int j) {
-    if (i == j) return;
-    const double w = weight(rng);
-    t.emplace_back(std::max(i, j), std::min(i, j), -w);
-    diagonal(i) += w;
-    diagonal(j) += w;
-  };
-  for (int i = 0; i < n; ++i) edge(i, (i + 1) % n);
-  for (int k = 0; k < extra_edges; ++k) edge(vertex(rng), vertex(rng));
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, diagonal(i));
-  SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());  // Lower triangle (duplicates sum).
-  return A;
+  return ShiftedLaplacian(n, 0.5, [&](auto&& edge) {
+    auto random_edge = [&](int i, int j) {
+      if (i != j) edge(i, j, weight(rng));  // No weight drawn for loops.
+    };
+    for (int i = 0; i < n; ++i) random_edge(i, (i + 1) % n);
+    for (int k = 0; k < extra_edges; ++k) {
+      const int i = vertex(rng);
+      random_edge(i, vertex(rng));
+    }
+  });
 }
 
 class SparseCholeskyFactorTest
@@ -206,25 +220,15 @@ TEST(SparseCholeskyFactor, ThreadsGiveIdenticalResults) {
 // factor has two large independent subtrees below a small top separator, so
 // the solves run split (bins and top).
 SparseMatrix GridSpd(int side) {
-  std::vector<Eigen::Triplet<double>> t;
-  const int n = side * side;
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(n, 0.25);
-  auto edge = [&](int i, int j, double w) {
-    t.emplace_back(std::max(i, j), std::min(i, j), -w);
-    diagonal(i) += w;
-    diagonal(j) += w;
-  };
-  for (int y = 0; y < side; ++y) {
-    for (int x = 0; x < side; ++x) {
-      const int i = y * side + x;
-      if (x + 1 < side) edge(i, i + 1, 1.0 + 0.01 * (i % 7));
-      if (y + 1 < side) edge(i, i + side, 1.0 + 0.01 * (i % 5));
+  return ShiftedLaplacian(side * side, 0.25, [&](auto&& edge) {
+    for (int y = 0; y < side; ++y) {
+      for (int x = 0; x < side; ++x) {
+        const int i = y * side + x;
+        if (x + 1 < side) edge(i, i + 1, 1.0 + 0.01 * (i % 7));
+        if (y + 1 < side) edge(i, i + side, 1.0 + 0.01 * (i % 5));
+      }
     }
-  }
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, diagonal(i));
-  SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  return A;
+  });
 }
 
 // The split schedule (bins solved concurrently, their updates of the top

@@ -539,7 +539,7 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
       const int up = parent_[super_start_[s + 1] - 1];
       if (up >= 0) super_parent[s] = column_super_[up];
     }
-    const TreeSplit split = SplitTree(super_parent, work, /*num_bins=*/2,
+    const TreeSplit split = SplitTree(super_parent, work, kTreeSplitBins,
                                       /*max_critical_fraction=*/0.85);
     VLOG(2) << "double-double factorization: top " << split.top_weight << " of "
             << split.total_weight << " multiply-adds, heaviest bin "
@@ -609,7 +609,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   // (super_bin_), each bin keeps lists of its own (a bin's supernodes
   // update only their ancestors: in the bin or in the top), which are
   // joined, in bin order, for the top's turn.
-  const int num_bins = super_bin_.empty() ? 0 : 2;
+  const int num_bins = this->num_bins();
   std::vector<std::vector<int>> heads(num_bins + 1,
                                       std::vector<int>(num_super, -1));
   std::vector<int> next(num_super, -1), pointer(num_super, 0);
@@ -770,16 +770,16 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   };
   bool ok = true;
   if (num_bins > 0) {
-    bool bin_ok[2] = {true, true};
+    bool bin_ok[kTreeSplitBins];
     ParallelParts(std::min(options_.num_threads, num_bins),
                   [&](int part, int parts) {
                     for (int b = part; b < num_bins; b += parts) {
                       bin_ok[b] = factor(b, &heads[b], 1);
                     }
                   });
-    ok = bin_ok[0] && bin_ok[1];
-    // The top's lists: bin 0's, then bin 1's (all their supernodes that
-    // still wait wait for a top supernode).
+    ok = std::all_of(bin_ok, bin_ok + num_bins, [](bool b) { return b; });
+    // The top's lists: bin 0's, then bin 1's, ... (every supernode still
+    // waiting in a bin's lists waits for a top supernode).
     std::vector<int>& top_head = heads[num_bins];
     for (int s = num_super - 1; ok && s >= 0; --s) {
       if (super_bin_[s] != -1) continue;
@@ -796,8 +796,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     ok = factor(0, &heads[0], options_.num_threads);
   }
   timed_out_ = timed_out;
-  if (!ok) return false;
-  return true;
+  return ok;
 }
 
 bool DoubleDoubleCholesky::Factorize(

@@ -45,6 +45,7 @@
 #include <vector>
 
 #include "ceres_sesync/internal/double_double.h"
+#include "ceres_sesync/internal/tree_split.h"
 
 namespace ceres_sesync::internal {
 
@@ -57,9 +58,10 @@ class DoubleDoubleCholesky {
     // bitwise identical either way (tests compare); false is for testing.
     bool vectorize = true;
     // Threads of the supernodal factorization: large elimination trees are
-    // split (tree_split.h) into two bins of subtrees, factored concurrently,
-    // and their top. The split depends on the matrix only: the results are
-    // bitwise the same for every thread count.
+    // split (tree_split.h) into bins of subtrees, factored concurrently, and
+    // their top, whose wide supernodes take their updates in column ranges
+    // over the threads. The split depends on the matrix only: the results
+    // are bitwise the same for every thread count.
     int num_threads = 1;
     // Factorizations of fewer multiply-adds (sum over columns of count^2 /
     // 2) are not split: a few milliseconds, where threads cost more than
@@ -118,7 +120,7 @@ class DoubleDoubleCholesky {
     return super_value_start_.empty() ? 0 : super_value_start_.back();
   }
   // After Analyze(): bins of the parallel factorization (0: not split).
-  int num_bins() const { return super_bin_.empty() ? 0 : 2; }
+  int num_bins() const { return super_bin_.empty() ? 0 : kTreeSplitBins; }
   // Whether Factorize() uses the SIMD kernels.
   bool vectorized() const { return vectorized_; }
 

@@ -205,9 +205,6 @@ int64_t SparseCholeskyFactor::top_entries() const {
 
 namespace {
 
-// Bins of the parallel solve (header). Two match the machines this library
-// is measured on; the schedule must not depend on the thread count.
-constexpr int kNumBins = 2;
 // Factors with fewer stored entries are solved unsplit: a solve with r rows
 // is ~4 r entries of work, below the parallel threshold of ThreadsFor() (1e7)
 // for every r <= 10 here, where a split only adds bookkeeping.
@@ -254,7 +251,7 @@ void SparseCholeskyFactor::BuildSchedule() {
     if (rows_[s] > 0) parent[s] = supernode_of[row_index_[row_begin_[s]]];
   }
   const TreeSplit split =
-      SplitTree(parent, weight, kNumBins, kMaxSplitCriticalPath);
+      SplitTree(parent, weight, kTreeSplitBins, kMaxSplitCriticalPath);
   VLOG(2) << "solve schedule: top " << split.top_weight << " of "
           << split.total_weight << " stored entries, heaviest bin "
           << split.heaviest_bin << (split.bin.empty() ? " (not split)" : "");
@@ -265,7 +262,7 @@ void SparseCholeskyFactor::BuildSchedule() {
   // accumulators.
   order_.clear();
   top_columns_.clear();
-  for (int b = 0; b < kNumBins; ++b) {
+  for (int b = 0; b < kTreeSplitBins; ++b) {
     for (int s = 0; s < num_supernodes; ++s) {
       if (bin[s] == b) order_.push_back(s);
     }

@@ -23,15 +23,15 @@
 // threads makes every thread stream the whole factor (and gather from its
 // own W at random rows): with r = 3 on two threads each still pays almost a
 // whole one-thread solve. Instead the elimination tree of the supernodes is
-// cut once, at construction, into kNumBins = 2 "bins" of disjoint subtrees of
-// about equal weight and the "top" (their common ancestors, with nested
-// dissection the top separators). Forward, the bins are solved concurrently,
-// each adding its updates of top rows into an accumulator of its own (extra
-// columns of W, to which the bins' row indices of top rows point), the
-// accumulators are added to the top in bin order, and the top is solved with
-// its rows split over threads; backward in reverse, the top's solution copied
-// into the accumulators for the bins to read. The schedule depends only on
-// the factor, never on the thread count, so results are bitwise the same for
+// cut once, at construction, into kTreeSplitBins = 2 "bins" of disjoint
+// subtrees of about equal weight and the "top" (their common ancestors, with
+// nested dissection the top separators). Forward, the bins are solved
+// concurrently, each adding its updates of top rows into an accumulator of its
+// own (extra columns of W, to which the bins' row indices of top rows point),
+// the accumulators are added to the top in bin order, and the top is solved
+// with its rows split over threads; backward in reverse, the top's solution
+// copied into the accumulators for the bins to read. The schedule depends only
+// on the factor, never on the thread count, so results are bitwise the same for
 // every thread count (they differ from an unsplit solve in round-off only:
 // the order in which updates of top rows are summed).
 

@@ -11,6 +11,11 @@
 
 namespace ceres_sesync::internal {
 
+// Bins of the splits used by the library: two, the cores of the machines it
+// is measured on. Fixed (never the thread count), so that the schedules, and
+// the results computed with them, are the same for every thread count.
+constexpr int kTreeSplitBins = 2;
+
 struct TreeSplit {
   // bin[s] in 0 .. num_bins - 1, or -1 for the top. Empty if not split.
   std::vector<int> bin;
