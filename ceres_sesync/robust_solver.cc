@@ -212,6 +212,14 @@ class WeightedProblem {
   int rebuilds_ = 0;
 };
 
+// The relative preconditioned gradient tolerance of the GNC steps' local
+// searches.
+double GncGradientTolerance(const RobustSolverOptions& o) {
+  return o.gnc_relative_gradient_tolerance > 0
+             ? o.gnc_relative_gradient_tolerance
+             : o.solver_options.relative_preconditioned_gradient_tolerance;
+}
+
 std::string CheckOptions(const RobustSolverOptions& o, int d) {
   if (!std::isfinite(o.inlier_threshold)) {
     return "inlier_threshold must be finite";
@@ -225,6 +233,10 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
   }
   if (o.max_iterations < 0) return "max_iterations must be >= 0";
   if (o.initial_max_rank < 0) return "initial_max_rank must be >= 0";
+  if (!(o.gnc_relative_gradient_tolerance >= 0) ||
+      !std::isfinite(o.gnc_relative_gradient_tolerance)) {
+    return "gnc_relative_gradient_tolerance must be a finite number >= 0";
+  }
   if (o.gnc_threshold_fractions.empty()) {
     return "gnc_threshold_fractions must not be empty";
   }
@@ -329,19 +341,18 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   const double c2 = InlierThreshold(options, d);
   s.inlier_threshold = c2;
 
-  // The first solve is Solve() itself (up to initial_max_rank). GNC's
-  // weighted solves then prove their certificates in double only (they
-  // decide saddle escapes; no bound of theirs is reported); each final
-  // inlier problem's proof uses the caller's arithmetic again. The
+  // The first solve is Solve() itself up to initial_max_rank. GNC's
+  // weighted solves then stop their local searches at
+  // gnc_relative_gradient_tolerance and prove their certificates in double
+  // only (they decide saddle escapes; no bound of theirs is reported); each
+  // final inlier problem is solved with the caller's options again. The
   // Staircase reads its options at every stage.
   SolverOptions solve_options = options.solver_options;
   const int r0 = options.solver_options.initial_rank > 0
                      ? options.solver_options.initial_rank
                      : d + 2;
-  if (options.initial_max_rank > 0) {
-    solve_options.max_rank = std::min(options.solver_options.max_rank,
-                                      std::max(options.initial_max_rank, r0));
-  }
+  solve_options.max_rank = std::min(options.solver_options.max_rank,
+                                    std::max(options.initial_max_rank, r0));
   WeightedProblem problem(graph, solve_options);
   problem.Start(start);
   auto invalid = [&]() {
@@ -451,6 +462,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     double previous_cost = surrogate(mu);
     run.status = RobustSolverSummary::Status::kMaxIterations;
     solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
+    solve_options.relative_preconditioned_gradient_tolerance =
+        GncGradientTolerance(options);
     for (int it = 0; it < options.max_iterations; ++it) {
       const auto step_start = Clock::now();
       MeasurementWeights next(m);
@@ -501,6 +514,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // at 1/2), solved from the last factor, proven in the caller's
     // arithmetic.
     solve_options.proof_arithmetic = options.solver_options.proof_arithmetic;
+    solve_options.relative_preconditioned_gradient_tolerance =
+        options.solver_options.relative_preconditioned_gradient_tolerance;
     run.accepted.assign(m, 0);
     for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
     // Solves the problem restricted to `set` from *Y_io (updated in place).
@@ -522,11 +537,15 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     for (size_t k = 0; k < m; ++k) {
       binary = binary && run.weights[k] == run.accepted[k];
     }
-    // A new solve unless the last one was this problem already, proven in
-    // the caller's arithmetic (GNC steps prove in double).
-    if ((!binary || (run.record.iterations > 0 &&
-                     options.solver_options.proof_arithmetic !=
-                         SolverOptions::ProofArithmetic::kDouble)) &&
+    // A new solve unless the last one was this problem already, solved with
+    // the caller's options (GNC steps stop at their own gradient tolerance
+    // and prove in double).
+    const bool gnc_options_differ =
+        options.solver_options.proof_arithmetic !=
+            SolverOptions::ProofArithmetic::kDouble ||
+        GncGradientTolerance(options) !=
+            options.solver_options.relative_preconditioned_gradient_tolerance;
+    if ((!binary || (run.record.iterations > 0 && gnc_options_differ)) &&
         !solve_accepted()) {
       return disconnected("the accepted measurements: ");
     }
@@ -744,15 +763,17 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   }
   out += "\nSelected run's GNC steps\n";
   line("%-34s %.3e\n", "Initial mu", initial_mu);
-  line("  %4s %11s %18s %8s %8s %5s %9s %s\n", "iter", "mu", "surrogate",
-       "w = 0", "w = 1", "rank", "time [s]", "solve");
+  line("  %4s %11s %18s %8s %8s %5s %6s %9s %10s %9s %s\n", "iter", "mu",
+       "surrogate", "w = 0", "w = 1", "rank", "iters", "opt. [s]", "verif. [s]",
+       "time [s]", "solve");
   for (size_t t = 0; t < history.size(); ++t) {
     const Iteration& h = history[t];
     SolverSummary status_only;
     status_only.status = h.status;
-    line("  %4d %11.4e %18.10g %8d %8d %5d %9.4f %s\n", static_cast<int>(t + 1),
-         h.mu, h.surrogate_cost, h.num_zero_weights, h.num_unit_weights, h.rank,
-         h.time_s, status_only.StatusString().c_str());
+    line("  %4d %11.4e %18.10g %8d %8d %5d %6d %9.4f %10.4f %9.4f %s\n",
+         static_cast<int>(t + 1), h.mu, h.surrogate_cost, h.num_zero_weights,
+         h.num_unit_weights, h.rank, h.solver_iterations, h.optimization_time_s,
+         h.verification_time_s, h.time_s, status_only.StatusString().c_str());
   }
   line("%-34s %s\n", "Final weights binary", weights_binary ? "yes" : "no");
   line("%-34s %d accepted, %d rejected\n", "Measurements", num_inliers,

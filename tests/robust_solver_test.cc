@@ -174,6 +174,54 @@ TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
   }
 }
 
+// GNC's steps stop their local searches early (gnc_relative_gradient_
+// tolerance) and prove in double; the reported inlier problem is still
+// solved with the caller's options, also when the last GNC step already had
+// binary weights (proof in double here, where that step would otherwise be
+// reused): its optimum is Solve()'s on the accepted measurements, to the
+// caller's tolerance (relative 1e-6 on the preconditioned gradient: F
+// within ~1e-12 F of the optimum; 1e-3 leaves ~1e-6 F).
+TEST(RobustSolver, InlierProblemIsSolvedWithTheCallersOptions) {
+  for (int d : {2, 3}) {
+    const PoseGraph clean = ChainGraph(d, 60, 60, false, 11, nullptr);
+    OutlierOptions o;
+    o.fraction = 0.4;
+    o.seed = 1;
+    PoseGraph corrupted;
+    ASSERT_TRUE(AddOutliers(clean, o, &corrupted, nullptr, nullptr));
+    RobustSolverOptions options = Options();
+    options.solver_options.proof_arithmetic =
+        SolverOptions::ProofArithmetic::kDouble;
+    // GNC runs until the weights are exactly 0 or 1 (then its last step
+    // solved the inlier problem already, loosely), and nothing solves it
+    // after GNC but the final solve under test.
+    options.weight_tolerance = 0;
+    options.relative_cost_tolerance = 0;
+    options.max_consistency_rounds = 0;
+    options.max_readmission_trials = 0;
+    // GNC steps far looser than the default 1e-3 (the difference would
+    // hide in F's last digits, RTR converging superlinearly).
+    options.gnc_relative_gradient_tolerance = 0.3;
+    RobustSolverSummary s;
+    SolveRobust(corrupted, options, &s);
+    ASSERT_TRUE(s.certified()) << s.FullReport();
+    ASSERT_TRUE(s.weights_binary);
+    PoseGraph accepted = corrupted;
+    accepted.measurements.clear();
+    for (size_t k = 0; k < s.edges.size(); ++k) {
+      if (s.edges[k].inlier) {
+        accepted.measurements.push_back(corrupted.measurements[k]);
+      }
+    }
+    SolverSummary plain;
+    Solve(accepted, options.solver_options, &plain);
+    ASSERT_TRUE(plain.certified());
+    EXPECT_NEAR(s.inlier_summary.objective, plain.objective,
+                1e-10 * plain.objective)
+        << "d = " << d;
+  }
+}
+
 // A 3 x 3 x 3 cube at the paper's noise (kappa 16.67, tau 75) plus random
 // wrong closures at 30% (cube and outlier seed `seed`).
 bool SmallNoisyCubeWithOutliers(uint64_t seed, PoseGraph* corrupted,
@@ -201,8 +249,13 @@ TEST(RobustSolver, UncertifiedFirstSolveThatFitsEveryMeasurementStartsGnc) {
   PoseGraph corrupted;
   std::vector<int> added;
   ASSERT_TRUE(SmallNoisyCubeWithOutliers(4, &corrupted, &added));
+  // The complete staircase in the first solve: at its rank-10 optimum the
+  // map fits the wrong closure (at the default rank r0 it does not, and
+  // run 1 already rejects it).
+  RobustSolverOptions options = Options();
+  options.initial_max_rank = options.solver_options.max_rank;
   RobustSolverSummary s;
-  SolveRobust(corrupted, Options(), &s);
+  SolveRobust(corrupted, options, &s);
   // The premise: the first solve fits every measurement, uncertified.
   ASSERT_FALSE(s.initial_summary.certified()) << s.FullReport();
   ASSERT_EQ(s.runs.size(), 2u);
@@ -268,7 +321,11 @@ TEST(RobustSolver, ScaledReadmissionKeepsOutAWrongClosureTheMapBendsToFit) {
   std::vector<int> added;
   ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
   ASSERT_FALSE(added.empty());
-  RobustSolverOptions bare = Options();
+  // Both with the complete staircase in the first solve (from its result
+  // GNC accepts the set that the bare rule then extends).
+  RobustSolverOptions options = Options();
+  options.initial_max_rank = options.solver_options.max_rank;
+  RobustSolverOptions bare = options;
   bare.readmission_min_scale = 1;
   RobustSolverSummary bare_rule;
   SolveRobust(corrupted, bare, &bare_rule);
@@ -278,7 +335,7 @@ TEST(RobustSolver, ScaledReadmissionKeepsOutAWrongClosureTheMapBendsToFit) {
   for (int k : added) accepted_wrong += bare_rule.edges[k].inlier;
   ASSERT_GE(accepted_wrong, 1) << bare_rule.FullReport();
   RobustSolverSummary scaled;
-  SolveRobust(corrupted, Options(), &scaled);
+  SolveRobust(corrupted, options, &scaled);
   EXPECT_TRUE(scaled.certified()) << scaled.FullReport();
   EXPECT_EQ(scaled.outlier_edges, added) << scaled.FullReport();
   EXPECT_EQ(scaled.readmissions, 0);
