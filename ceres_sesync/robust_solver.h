@@ -33,14 +33,16 @@
 //
 // Each weighted solve is a weighted SE-Sync problem (weights multiply kappa
 // and tau: internal/measurement_weights.h) run by the same staircase as
-// Solve(), warm-started from the previous factor Y (its negligible
-// directions dropped), its data matrices re-weighted in place (same
-// sparsity, symbolic analyses reused) or, once measurements have weight 0,
-// rebuilt without them (their fill is the dominant cost). The first solve
-// (all weights 1) seeds mu_0 = g^2 / (2 max_k f_k - g^2) with its residuals
-// (g^2: GNC's threshold), then mu <- mu_step * mu after every weight update.
-// If every f_k of the first solve is within c^2 and it is certified, it is
-// the answer (nothing rejected); uncertified (a wrong closure can bend a
+// Solve() (its local searches stopped at gnc_relative_gradient_tolerance),
+// warm-started from the previous factor Y (its negligible directions
+// dropped), its data matrices re-weighted in place (same sparsity, symbolic
+// analyses reused) or, once measurements have weight 0, rebuilt without them
+// (their fill is the dominant cost). The first solve (all weights 1, at the
+// initial rank: initial_max_rank) seeds mu_0 = g^2 / (2 max_k f_k - g^2)
+// with its residuals (g^2: GNC's threshold), then mu <- mu_step * mu after
+// every weight update. If every f_k of the first solve is within c^2 (its
+// staircase then continues to max_rank) and it is certified, it is the
+// answer (nothing rejected); uncertified (a wrong closure can bend a
 // small map until it fits, leaving the relaxation inexact), GNC runs at
 // each threshold g^2 below the largest f_k (above it every weight stays 1).
 // GNC stops when the weights are binary (each within weight_tolerance of 0
@@ -118,10 +120,11 @@ struct RobustSolverOptions {
   // itself. Without outliers the first solve is the inlier problem, and it
   // continues to solver_options.max_rank if it needs to (the result is then
   // Solve()'s). Measured (bench/results/outliers_gnc_effort.md, random
-  // outliers at 10/30/50%, 3 seeds, GNC tolerance 1e-3): intel and kitti_00
-  // 17 of 18 runs exact at r0, 16 with the full first solve, 1.5x and 1.7x
-  // faster; 154 noisy 3x3x3/4x4x4 cubes: 90 exact outlier sets at r0, 91
-  // with the full first solve.
+  // outliers at 10/30/50%, 3 seeds, GNC steps at 1e-3): intel and kitti_00
+  // 17 of 18 runs exact with either first solve, 1.24x (intel) and 1.25x
+  // (kitti_00) faster at r0; 154 noisy 3x3x3/4x4x4 cubes: 90 exact outlier
+  // sets at r0, 91 with the full first solve; cubicle + 10% outliers: 397
+  // -> 217 s (both changes).
   int initial_max_rank = 0;
 
   // Relative preconditioned gradient tolerance of the local searches of the
