@@ -212,14 +212,6 @@ class WeightedProblem {
   int rebuilds_ = 0;
 };
 
-// The relative preconditioned gradient tolerance of the GNC steps' local
-// searches.
-double GncGradientTolerance(const RobustSolverOptions& o) {
-  return o.gnc_relative_gradient_tolerance > 0
-             ? o.gnc_relative_gradient_tolerance
-             : o.solver_options.relative_preconditioned_gradient_tolerance;
-}
-
 std::string CheckOptions(const RobustSolverOptions& o, int d) {
   if (!std::isfinite(o.inlier_threshold)) {
     return "inlier_threshold must be finite";
@@ -462,8 +454,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     double previous_cost = surrogate(mu);
     run.status = RobustSolverSummary::Status::kMaxIterations;
     solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
-    solve_options.relative_preconditioned_gradient_tolerance =
-        GncGradientTolerance(options);
+    if (options.gnc_relative_gradient_tolerance > 0) {
+      solve_options.relative_preconditioned_gradient_tolerance =
+          options.gnc_relative_gradient_tolerance;
+    }
     for (int it = 0; it < options.max_iterations; ++it) {
       const auto step_start = Clock::now();
       MeasurementWeights next(m);
@@ -511,11 +505,9 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     run.weights_binary = Binary(run.weights, options.weight_tolerance);
 
     // The problem restricted to the accepted measurements (weights rounded
-    // at 1/2), solved from the last factor, proven in the caller's
-    // arithmetic.
-    solve_options.proof_arithmetic = options.solver_options.proof_arithmetic;
-    solve_options.relative_preconditioned_gradient_tolerance =
-        options.solver_options.relative_preconditioned_gradient_tolerance;
+    // at 1/2), solved from the last factor with the caller's options (the
+    // Staircase refers to solve_options, so it is restored in place).
+    solve_options = options.solver_options;
     run.accepted.assign(m, 0);
     for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
     // Solves the problem restricted to `set` from *Y_io (updated in place).

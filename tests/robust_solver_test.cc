@@ -142,17 +142,23 @@ TEST(RobustSolver, WithoutOutliersEqualsSolve) {
   }
 }
 
+// A noisy 60-pose chain with 60 loop closures plus 40% random wrong ones.
+bool NoisyChainWithOutliers(int d, PoseGraph* corrupted,
+                            std::vector<int>* added) {
+  const PoseGraph clean = ChainGraph(d, 60, 60, false, 11, nullptr);
+  OutlierOptions o;
+  o.fraction = 0.4;
+  o.seed = 1;
+  return AddOutliers(clean, o, corrupted, added, nullptr);
+}
+
 // Noisy data with outliers: the weights end binary and the verdicts follow
 // them; the outliers are exactly the added measurements.
 TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
   for (int d : {2, 3}) {
-    const PoseGraph clean = ChainGraph(d, 60, 60, false, 11, nullptr);
-    OutlierOptions o;
-    o.fraction = 0.4;
-    o.seed = 1;
     PoseGraph corrupted;
     std::vector<int> added;
-    ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+    ASSERT_TRUE(NoisyChainWithOutliers(d, &corrupted, &added));
     RobustSolverSummary s;
     SolveRobust(corrupted, Options(), &s);
     ASSERT_EQ(s.status, RobustSolverSummary::Status::kConverged)
@@ -177,18 +183,15 @@ TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
 // GNC's steps stop their local searches early (gnc_relative_gradient_
 // tolerance) and prove in double; the reported inlier problem is still
 // solved with the caller's options, also when the last GNC step already had
-// binary weights (proof in double here, where that step would otherwise be
-// reused): its optimum is Solve()'s on the accepted measurements, to the
-// caller's tolerance (relative 1e-6 on the preconditioned gradient: F
-// within ~1e-12 F of the optimum; 1e-3 leaves ~1e-6 F).
+// binary weights and the caller proves in double (that step's problem is
+// then the inlier problem itself, solved loosely): its optimum is Solve()'s on
+// the accepted measurements, to the caller's tolerance (relative 1e-6 on the
+// preconditioned gradient: F within ~1e-12 F of the optimum; 1e-3 leaves ~1e-6
+// F).
 TEST(RobustSolver, InlierProblemIsSolvedWithTheCallersOptions) {
   for (int d : {2, 3}) {
-    const PoseGraph clean = ChainGraph(d, 60, 60, false, 11, nullptr);
-    OutlierOptions o;
-    o.fraction = 0.4;
-    o.seed = 1;
     PoseGraph corrupted;
-    ASSERT_TRUE(AddOutliers(clean, o, &corrupted, nullptr, nullptr));
+    ASSERT_TRUE(NoisyChainWithOutliers(d, &corrupted, nullptr));
     RobustSolverOptions options = Options();
     options.solver_options.proof_arithmetic =
         SolverOptions::ProofArithmetic::kDouble;
