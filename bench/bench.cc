@@ -101,6 +101,7 @@ DEFINE_int32(lbfgs_repeats, 1,
 namespace ceres_sesync {
 namespace {
 
+using bench::BlasLibrary;
 using bench::CeresStatus;
 using bench::Clock;
 using bench::CsvField;
@@ -616,7 +617,8 @@ int main(int argc, char** argv) {
      << std::max(1, std::min(repeats, FLAGS_odometry_repeats))
      << "; Ceres time limit " << FLAGS_ceres_max_time
      << " s. Peak RSS of the whole run: " << Fmt("%.0f", PeakRssMiB())
-     << " MiB.\n";
+     << " MiB. BLAS (CHOLMOD's supernodal kernels, both sides): "
+     << BlasLibrary() << ".\n";
   std::fputs(md.str().c_str(), stdout);
 
   std::error_code ec;

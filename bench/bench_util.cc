@@ -1,5 +1,6 @@
 #include "bench/bench_util.h"
 
+#include <dlfcn.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -85,6 +86,19 @@ double PeakRssMiB() {
     }
   }
   return NAN;
+}
+
+std::string BlasLibrary() {
+  void* symbol = dlsym(RTLD_DEFAULT, "dgemm_");
+  Dl_info info;
+  if (symbol == nullptr || dladdr(symbol, &info) == 0 ||
+      info.dli_fname == nullptr) {
+    return "unknown";
+  }
+  // Follow the alternatives' links (libblas.so.3 -> .../atlas/libblas.so.3).
+  char resolved[4096];
+  if (realpath(info.dli_fname, resolved) != nullptr) return resolved;
+  return info.dli_fname;
 }
 
 std::string CeresStatus(const CeresBaselineSummary& summary) {

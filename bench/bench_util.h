@@ -69,6 +69,12 @@ bool RunInChildProcess(double timeout_s, double max_memory_gb, Fn&& fn,
       sizeof(Result), failure);
 }
 
+// The shared library whose dgemm_ this process calls (CHOLMOD's supernodal
+// factorizations, Ceres's and SE-Sync's alike, run in it: Debian's ATLAS and
+// OpenBLAS differ ~2x there), resolved through symbolic links; "unknown" if
+// it cannot be told.
+std::string BlasLibrary();
+
 // How a Ceres solve ended: converged, timeout, max_iterations,
 // no_convergence, or Ceres's termination type.
 std::string CeresStatus(const CeresBaselineSummary& summary);

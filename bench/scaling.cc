@@ -101,6 +101,7 @@ DEFINE_string(out_dir, ".", "Directory for scaling.csv and scaling.md.");
 namespace ceres_sesync {
 namespace {
 
+using bench::BlasLibrary;
 using bench::Clock;
 using bench::CsvField;
 using bench::Fmt;
@@ -421,8 +422,8 @@ int main(int argc, char** argv) {
   md << "# Scaling: SE-Sync vs Ceres PDL-GN and LM from the chordal "
         "initialization\n\n"
      << "Each run in its own process; " << FLAGS_num_threads << " thread(s); "
-     << std::thread::hardware_concurrency()
-     << " hardware threads; load average (1 / 5 / 15 min) at start "
+     << std::thread::hardware_concurrency() << " hardware threads; BLAS "
+     << BlasLibrary() << "; load average (1 / 5 / 15 min) at start "
      << load_at_start << ", at end " << LoadAverage()
      << " (timings taken under load are not comparable); Ceres limit "
      << FLAGS_ceres_max_time << " s; address-space limit per run "
