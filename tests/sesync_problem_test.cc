@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "Eigen/Dense"
+#include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/internal/sesync_cost.h"
 #include "ceres_sesync/pose_graph.h"
 #include "ceres_sesync/stiefel_manifold.h"
@@ -617,6 +618,37 @@ TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
 
 // The preconditioners: the documented dense operators, and symmetric positive
 // definite on the tangent space (the operator Proj o P o Proj).
+// MultiplyQ where Lbar's fill is heavy enough for CHOLMOD's supernodal layout
+// (a 3D lattice with loop closures to half of the poses within 4 lattice
+// units: Lbar nearly dense), whose factor its solves then read. Reference:
+// Q = D - Vbar^T Lbar^{-1} Vbar from the problem's own sparse matrices with a
+// dense Cholesky of Lbar (the matrices themselves are checked against the
+// paper's Q above; this checks the solves).
+TEST(SESyncProblem, MultiplyQMatchesDenseQWithSupernodalLbar) {
+  CubeOptions options;
+  options.side = 10;
+  options.loop_closure_probability = 0.5;
+  options.loop_closure_radius = 4;
+  options.kappa = 100;
+  options.tau = 400;
+  PoseGraph graph;
+  ASSERT_TRUE(GenerateCube(options, &graph, nullptr, nullptr));
+  SESyncProblem problem(graph);
+  ASSERT_TRUE(problem.ok());
+  ASSERT_TRUE(problem.LbarIsSupernodal());
+  const MatrixXd Vbar(problem.Vbar());
+  const MatrixXd Lbar(problem.Lbar());
+  const MatrixXd Q =
+      MatrixXd(problem.D()) - Vbar.transpose() * Lbar.llt().solve(Vbar);
+  std::mt19937_64 rng(12);
+  const MatrixXd Y = Gaussian(5, 3 * graph.num_poses, &rng);
+  MatrixXd YQ;
+  problem.MultiplyQ(Y, &YQ);
+  // Round-off of the sparse products and of two Cholesky solves with Lbar
+  // (the lattice is compact and densely connected: well conditioned).
+  EXPECT_LT(RelativeError(YQ, Y * Q), 1e-10);
+}
+
 // ReleaseNumericFactor() frees the values and keeps the symbolic analysis:
 // a copy taken before stays valid, and refactorizing (simplicial or
 // supernodal) gives the same factor to the last bit.

@@ -254,18 +254,22 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
   // One fill-reducing ordering of the vertices (on the pattern of M
   // collapsed to vertices: L(W^tau) for a pose graph) serves Lbar here and
   // the augmented matrices of certificate_matrix.h, whose (d+1)-blocks
-  // multiply its flops by about (d+1)^3 / 2. CHOLMOD's default choice (AMD
-  // here) is cheap; on large maps nested dissection (METIS) costs more to
-  // compute but leaves much less fill: measured on a 50,000-pose 2D city
-  // walk, 2.5x fewer flops (1.2x on city10000 and a 27,000-pose cube). So METIS
-  // is tried when the predicted flops of the augmented matrix exceed 2e4 per
-  // pose (about where its ~7 us per pose pays off), and kept if it predicts
-  // fewer flops.
+  // multiply its flops by about (d+1)^3 / 2. AMD is cheap; on large maps
+  // nested dissection (METIS) costs more to compute but leaves much less
+  // fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops (1.2x on
+  // city10000 and a 27,000-pose cube). So METIS is tried when the predicted
+  // flops of the augmented matrix exceed 2e4 per pose (about where its ~7 us
+  // per pose pays off), and kept if it predicts fewer flops. The first
+  // analysis is AMD alone: CHOLMOD's default would itself go on to METIS
+  // when AMD's fill is heavy, which then ran twice (10^6-pose city: 9.9 s
+  // for that analysis, 7.8 s for the second METIS).
   {
     SparseMatrix pattern(num_vertices, num_vertices);
     pattern.setFromTriplets(vertex_pattern.begin(), vertex_pattern.end());
     CholmodFactor analysis;
     ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
+    analysis.cholmod().nmethods = 1;
+    analysis.cholmod().method[0].ordering = CHOLMOD_AMD;
     analysis.analyzePattern(pattern);
     vertex_ordering_ = analysis.Ordering();
     const double block_flops = std::pow(d_ + 1.0, 3) / 2;
@@ -296,8 +300,11 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
       lbar_ordering.push_back(layout.reduced(node));
     }
   }
+  // Supernodal where Lbar's fill is heavy (10^6-pose city: 3.3 s, and the
+  // data stage 32.7 -> 25.7 s against simplicial); the products with Q use
+  // the extracted copy either way.
   lbar_factor_ = std::make_unique<CholmodFactor>();
-  ConfigureCholmod(CholmodLayout::kSimplicial, lbar_factor_.get());
+  ConfigureCholmod(CholmodLayout::kAutomatic, lbar_factor_.get());
   lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
   FactorizeLbar();
 }

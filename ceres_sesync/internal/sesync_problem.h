@@ -337,6 +337,11 @@ class SESyncProblem {
   // factorizations of matrices containing Lbar make in its rows. O(nnz) per
   // call.
   double LbarBackwardError() const;
+  // Whether CHOLMOD chose the supernodal layout for Lbar's factor (heavy
+  // fill: large maps, 3D lattices).
+  bool LbarIsSupernodal() const {
+    return lbar_factor_ != nullptr && lbar_factor_->IsSupernodal();
+  }
 
   // Bounds on the rounding of the matrices as stored against their exact
   // values from the measurements (ForEachDataTerm), per row of
