@@ -621,9 +621,9 @@ TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
 // MultiplyQ where Lbar's fill is heavy enough for CHOLMOD's supernodal layout
 // (a 3D lattice with loop closures to half of the poses within 4 lattice
 // units: Lbar nearly dense), whose factor its solves then read. Reference:
-// Q = D - Vbar^T Lbar^{-1} Vbar from the problem's own sparse matrices with a
-// dense Cholesky of Lbar (the matrices themselves are checked against the
-// paper's Q above; this checks the solves).
+// Y Q = Y D - Y Vbar^T Lbar^{-1} Vbar from the problem's own sparse matrices
+// with a dense Cholesky of Lbar (the matrices themselves are checked against
+// the paper's Q above; this checks the solves).
 TEST(SESyncProblem, MultiplyQMatchesDenseQWithSupernodalLbar) {
   CubeOptions options;
   options.side = 10;
@@ -638,15 +638,16 @@ TEST(SESyncProblem, MultiplyQMatchesDenseQWithSupernodalLbar) {
   ASSERT_TRUE(problem.LbarIsSupernodal());
   const MatrixXd Vbar(problem.Vbar());
   const MatrixXd Lbar(problem.Lbar());
-  const MatrixXd Q =
-      MatrixXd(problem.D()) - Vbar.transpose() * Lbar.llt().solve(Vbar);
   std::mt19937_64 rng(12);
   const MatrixXd Y = Gaussian(5, 3 * graph.num_poses, &rng);
+  // Y Q without forming Q (Lbar is symmetric).
+  const MatrixXd YVt_Linv = Lbar.llt().solve(Vbar * Y.transpose()).transpose();
+  const MatrixXd reference = Y * MatrixXd(problem.D()) - YVt_Linv * Vbar;
   MatrixXd YQ;
   problem.MultiplyQ(Y, &YQ);
   // Round-off of the sparse products and of two Cholesky solves with Lbar
   // (the lattice is compact and densely connected: well conditioned).
-  EXPECT_LT(RelativeError(YQ, Y * Q), 1e-10);
+  EXPECT_LT(RelativeError(YQ, reference), 1e-10);
 }
 
 // ReleaseNumericFactor() frees the values and keeps the symbolic analysis:
