@@ -129,6 +129,38 @@ TEST(SESyncProblem, MultiplyQMatchesDenseQ) {
   }
 }
 
+// MultiplyQ where Lbar's fill is heavy enough for CHOLMOD's supernodal layout
+// (a 3D lattice with loop closures to half of the poses within 4 lattice
+// units: Lbar nearly dense), whose factor its solves then read. Reference:
+// Y Q = Y D - Y Vbar^T Lbar^{-1} Vbar from the problem's own sparse matrices
+// with a dense Cholesky of Lbar (the matrices themselves are checked against
+// the paper's Q above; this checks the solves).
+TEST(SESyncProblem, MultiplyQMatchesDenseReferenceWithSupernodalLbar) {
+  CubeOptions options;
+  options.side = 10;
+  options.loop_closure_probability = 0.5;
+  options.loop_closure_radius = 4;
+  options.kappa = 100;
+  options.tau = 400;
+  PoseGraph graph;
+  ASSERT_TRUE(GenerateCube(options, &graph, nullptr, nullptr));
+  SESyncProblem problem(graph);
+  ASSERT_TRUE(problem.ok());
+  ASSERT_TRUE(problem.LbarIsSupernodal());
+  const MatrixXd Vbar(problem.Vbar());
+  const MatrixXd Lbar(problem.Lbar());
+  std::mt19937_64 rng(12);
+  const MatrixXd Y = Gaussian(5, 3 * graph.num_poses, &rng);
+  // Y Q without forming Q (Lbar is symmetric).
+  const MatrixXd YVt_Linv = Lbar.llt().solve(Vbar * Y.transpose()).transpose();
+  const MatrixXd reference = Y * MatrixXd(problem.D()) - YVt_Linv * Vbar;
+  MatrixXd YQ;
+  problem.MultiplyQ(Y, &YQ);
+  // Round-off of the sparse products and of two Cholesky solves with Lbar
+  // (the lattice is compact and densely connected: well conditioned).
+  EXPECT_LT(RelativeError(YQ, reference), 1e-10);
+}
+
 // The documented sparse pieces: M = [L(W^tau) -V; -V^T D], Lbar and Vbar drop
 // pose 0, and L(G^rho) = D - Sigma is Q of the same graph with t~ = 0.
 TEST(SESyncProblem, SparseBlocksMatchDenseDataMatrix) {
@@ -616,40 +648,6 @@ TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
   }
 }
 
-// The preconditioners: the documented dense operators, and symmetric positive
-// definite on the tangent space (the operator Proj o P o Proj).
-// MultiplyQ where Lbar's fill is heavy enough for CHOLMOD's supernodal layout
-// (a 3D lattice with loop closures to half of the poses within 4 lattice
-// units: Lbar nearly dense), whose factor its solves then read. Reference:
-// Y Q = Y D - Y Vbar^T Lbar^{-1} Vbar from the problem's own sparse matrices
-// with a dense Cholesky of Lbar (the matrices themselves are checked against
-// the paper's Q above; this checks the solves).
-TEST(SESyncProblem, MultiplyQMatchesDenseQWithSupernodalLbar) {
-  CubeOptions options;
-  options.side = 10;
-  options.loop_closure_probability = 0.5;
-  options.loop_closure_radius = 4;
-  options.kappa = 100;
-  options.tau = 400;
-  PoseGraph graph;
-  ASSERT_TRUE(GenerateCube(options, &graph, nullptr, nullptr));
-  SESyncProblem problem(graph);
-  ASSERT_TRUE(problem.ok());
-  ASSERT_TRUE(problem.LbarIsSupernodal());
-  const MatrixXd Vbar(problem.Vbar());
-  const MatrixXd Lbar(problem.Lbar());
-  std::mt19937_64 rng(12);
-  const MatrixXd Y = Gaussian(5, 3 * graph.num_poses, &rng);
-  // Y Q without forming Q (Lbar is symmetric).
-  const MatrixXd YVt_Linv = Lbar.llt().solve(Vbar * Y.transpose()).transpose();
-  const MatrixXd reference = Y * MatrixXd(problem.D()) - YVt_Linv * Vbar;
-  MatrixXd YQ;
-  problem.MultiplyQ(Y, &YQ);
-  // Round-off of the sparse products and of two Cholesky solves with Lbar
-  // (the lattice is compact and densely connected: well conditioned).
-  EXPECT_LT(RelativeError(YQ, reference), 1e-10);
-}
-
 // ReleaseNumericFactor() frees the values and keeps the symbolic analysis:
 // a copy taken before stays valid, and refactorizing (simplicial or
 // supernodal) gives the same factor to the last bit.
@@ -689,6 +687,8 @@ TEST(CholmodFactor, ReleaseKeepsAnalysisAndCopies) {
   }
 }
 
+// The preconditioners: the documented dense operators, and symmetric positive
+// definite on the tangent space (the operator Proj o P o Proj).
 TEST(SESyncPreconditioner, AllTypesAreDocumentedOperatorsAndSpdOnTangent) {
   std::mt19937_64 rng(31);
   for (const PoseGraph& graph : CostGraphs()) {
