@@ -148,6 +148,26 @@ struct SolverOptions {
   // lowers F(x) (and the suboptimality bound).
   bool refine_rounded_solution = true;
 
+  // After a saddle escape the descent at the new rank is long and flat, and
+  // the certificate usually becomes provable within the tolerance well
+  // before the local solver's own tests are met (a 10^5-pose city with a
+  // rank-4 saddle: after 185 of 379 Hessian-vector products). With this on,
+  // levels entered by an escape test the certificate during their
+  // optimization: one factorization of S + eta I, eta half the tolerance's
+  // shift (certification_max_relative_bound * F(Y) / (2 d n)), in double
+  // where double can prove it, else double-double, whenever the
+  // Hessian-vector products since the last test number at least twice a
+  // factorization's cost in products (CHOLMOD's flop prediction; not a
+  // time, so results do not depend on the machine's load) and half the
+  // level's products so far. The level stops at the first test that
+  // passes; its proof stands, and the level's verification tightens it in
+  // double where double reaches below it. The returned poses are the same
+  // (rounding refines them to the same local optimum); the proven bound is
+  // within the tolerance but can be looser than after a converged descent
+  // (large maps, where only double-double reaches it: about half the
+  // tolerance). Off: every level runs to the local solver's tests.
+  bool test_certificate_after_escape = true;
+
   // Threads for the products with Q, the triangular solves (two subtrees of
   // the factor's elimination tree at a time), the double-double proof's
   // factorization (likewise, plus column ranges of its top separators), and
@@ -199,9 +219,15 @@ struct SolverSummary {
     double lambda_min_estimate = 0;
     double optimize_time_s = 0;
     double verify_time_s = 0;
-    // The level's certificate factorizations: double, double-double.
+    // The level's certificate factorizations: double, double-double
+    // (including those of certificate tests).
     int factorizations = 0;
     int extended_factorizations = 0;
+    // Certificate tests during the optimization (test_certificate_after_
+    // escape) and whether one passed (the level's optimization then stopped
+    // there); their time counts in verify_time_s, not optimize_time_s.
+    int certificate_tests = 0;
+    bool certificate_test_passed = false;
   };
 
   Status status = Status::kInvalidInput;

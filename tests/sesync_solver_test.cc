@@ -21,6 +21,7 @@
 #include "Eigen/Dense"
 #include "ceres_sesync/ceres_baseline.h"
 #include "ceres_sesync/chordal_initialization.h"
+#include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/pose_graph.h"
@@ -469,6 +470,79 @@ TEST(SESyncSolver, SmallDatasetsMatchPublishedOptima) {
     std::printf("%s: F = %.6e, rel. bound %.2e, %.3f s\n", c.file, s.objective,
                 s.relative_suboptimality_bound, s.total_time_s);
   }
+}
+
+// A 1000-pose city at kappa 10 (seed 1) has a rank-4 saddle: the staircase
+// escapes to rank 5, where the relaxation is not exact (its bound is about
+// the rounding gap, 2.3e-4). Certificate tests during the rank-5 descent
+// (SolverOptions::test_certificate_after_escape) stop it once one passes;
+// the run is the one without tests, stopped earlier, so the poses are the
+// same and both lower bounds hold for both objectives.
+TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
+  CityOptions city;
+  city.num_poses = 1000;
+  city.kappa = 10;
+  city.seed = 1;
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(GenerateCity(city, &graph, nullptr, &error)) << error;
+  SolverOptions on;
+  on.num_threads = 1;
+  SolverOptions off = on;
+  off.test_certificate_after_escape = false;
+  SolverSummary s_on, s_off;
+  const Poses x_on = Solve(graph, on, &s_on);
+  const Poses x_off = Solve(graph, off, &s_off);
+  ASSERT_EQ(s_off.status, Status::kCertifiedOptimum) << s_off.FullReport();
+  ASSERT_EQ(s_off.levels.size(), 2u) << "the fixture must escape a saddle";
+  EXPECT_EQ(s_on.status, Status::kCertifiedOptimum) << s_on.FullReport();
+  ASSERT_EQ(s_on.levels.size(), 2u) << s_on.FullReport();
+  // No tests at the first level (not entered by an escape), none when off.
+  EXPECT_EQ(s_on.levels[0].certificate_tests, 0);
+  for (const SolverSummary::Level& level : s_off.levels) {
+    EXPECT_EQ(level.certificate_tests, 0);
+    EXPECT_FALSE(level.certificate_test_passed);
+  }
+  // Identical up to the stop: the same first level, fewer iterations after.
+  EXPECT_EQ(s_on.levels[0].hessian_vector_products,
+            s_off.levels[0].hessian_vector_products);
+  EXPECT_EQ(s_on.levels[0].sdp_value, s_off.levels[0].sdp_value);
+  const SolverSummary::Level& tested = s_on.levels[1];
+  EXPECT_GE(tested.certificate_tests, 1);
+  EXPECT_TRUE(tested.certificate_test_passed);
+  EXPECT_EQ(tested.termination, "certificate test passed");
+  EXPECT_TRUE(tested.certified);
+  EXPECT_GE(tested.factorizations + tested.extended_factorizations,
+            tested.certificate_tests + 1);
+  EXPECT_LT(tested.iterations, s_off.levels[1].iterations);
+  EXPECT_LT(s_on.hessian_vector_products, s_off.hessian_vector_products);
+  // Rounding refines both to the same local optimum.
+  EXPECT_NEAR(s_on.objective, s_off.objective, 1e-10 * s_off.objective);
+  ASSERT_EQ(x_on.size(), x_off.size());
+  for (size_t i = 0; i < x_on.size(); ++i) {
+    EXPECT_LE((x_on[i].R - x_off[i].R).norm(), 1e-6) << i;
+    EXPECT_LE((x_on[i].t - x_off[i].t).norm(), 1e-5) << i;
+  }
+  EXPECT_LE(s_on.lower_bound, s_off.objective);
+  EXPECT_LE(s_off.lower_bound, s_on.objective);
+  EXPECT_LE(s_on.relative_suboptimality_bound,
+            on.certification_max_relative_bound);
+  // The first level's shift is the witness's (no tightening: the next level
+  // replaces it), above the negative curvature it found.
+  EXPECT_LT(s_on.levels[0].lambda_min_estimate, 0);
+  EXPECT_GT(s_on.levels[0].eta, -1.5 * s_on.levels[0].lambda_min_estimate);
+
+  // At the maximum rank nothing replaces the bound: it is tightened to just
+  // above the estimate of lambda_min(S).
+  SolverOptions last = on;
+  last.max_rank = 4;
+  SolverSummary s_last;
+  Solve(graph, last, &s_last);
+  EXPECT_EQ(s_last.status, Status::kMaxRankReached) << s_last.FullReport();
+  ASSERT_EQ(s_last.levels.size(), 1u);
+  EXPECT_LT(s_last.levels[0].lambda_min_estimate, 0);
+  EXPECT_LE(s_last.levels[0].eta, -1.1 * s_last.levels[0].lambda_min_estimate);
+  EXPECT_GT(s_last.lower_bound, 0);
 }
 
 }  // namespace

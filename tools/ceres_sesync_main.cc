@@ -83,6 +83,7 @@ const std::vector<Command>& Commands() {
         {"preconditioner"},
         {"local_solver"},
         {"gradient_tolerance"},
+        {"test_certificate_after_escape"},
         {"max_time"},
         {"num_threads"},
         {"proof_arithmetic"},

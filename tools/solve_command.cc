@@ -32,6 +32,12 @@ DEFINE_double(
     ceres_sesync::SolverOptions().relative_preconditioned_gradient_tolerance,
     "Relative preconditioned gradient tolerance of the "
     "local solver.");
+DEFINE_bool(test_certificate_after_escape,
+            ceres_sesync::SolverOptions().test_certificate_after_escape,
+            "After a saddle escape, test the certificate during the new "
+            "rank's optimization and stop it once the bound is provably "
+            "within the tolerance (the poses are the same; the bound can be "
+            "looser than after a converged descent).");
 DEFINE_bool(components, false,
             "Solve a disconnected graph per connected component, each in its "
             "own gauge (its first pose, or its FIX pose, fixed); the report "
@@ -93,6 +99,12 @@ void AddSummary(const SolverSummary& summary, internal::JsonWriter* json,
   json->Int("factorizations", summary.factorizations);
   json->Int("extended_factorizations", summary.extended_factorizations);
   json->Number("extended_time_s", summary.extended_proof_time_s);
+  int certificate_tests = 0;
+  for (const SolverSummary::Level& level : summary.levels) {
+    certificate_tests += level.certificate_tests;
+  }
+  // During the descents after saddle escapes (test_certificate_after_escape).
+  json->Int("certificate_tests", certificate_tests);
   json->Number("verification_time_s", summary.verification_time_s);
   json->EndObject();
   json->BeginObject("time_s");
@@ -177,6 +189,7 @@ int RunSolve(const Args& args) {
   options.seed = FLAGS_seed;
   options.initial_rank = FLAGS_initial_rank;
   options.max_rank = FLAGS_max_rank;
+  options.test_certificate_after_escape = FLAGS_test_certificate_after_escape;
   options.max_time_s = FLAGS_max_time;
   options.verbose = FLAGS_verbose;
   options.num_threads = FLAGS_num_threads;

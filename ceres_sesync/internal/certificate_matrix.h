@@ -16,6 +16,7 @@
 #ifndef CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 #define CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <vector>
@@ -118,6 +119,15 @@ class CertificateMatrix {
   int double_factorizations() const { return double_factorizations_; }
   int extended_factorizations() const { return extended_factorizations_; }
   double extended_time_s() const { return extended_time_s_; }
+
+  // A factorization's cost in units of the two triangular solves with r
+  // right-hand sides that one preconditioned Hessian-vector product applies
+  // with a factor of K's pattern: flops / (4 r nnz(L)), CHOLMOD's symbolic
+  // prediction (deterministic, unlike a measured time).
+  double FactorizationCostInSolves(int r) const {
+    return factor_.analysis_flops() /
+           (4.0 * r * std::max(1.0, factor_.analysis_nonzeros()));
+  }
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }

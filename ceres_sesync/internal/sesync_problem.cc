@@ -191,6 +191,8 @@ void CholmodFactor::AnalyzePatternWithOrdering(const SparseMatrix& lower,
   common.nmethods = saved_methods;
   common.method[0].ordering = saved_ordering;
   CHECK(m_cholmodFactor != nullptr) << "cholmod_analyze_p failed";
+  analysis_flops_ = common.fl;
+  analysis_nonzeros_ = common.lnz;
   m_isInitialized = true;
   m_info = Eigen::Success;
   m_analysisIsOk = true;

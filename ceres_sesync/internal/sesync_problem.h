@@ -86,6 +86,13 @@ class CholmodFactor
   // After analyzePattern(): whether CHOLMOD chose the supernodal layout
   // (dense fill, expensive factorizations).
   bool IsSupernodal() const;
+  // After AnalyzePatternWithOrdering(): CHOLMOD's predicted flop count of a
+  // factorization and the number of nonzeros of L.
+  double analysis_flops() const { return analysis_flops_; }
+  double analysis_nonzeros() const { return analysis_nonzeros_; }
+
+ private:
+  double analysis_flops_ = 0, analysis_nonzeros_ = 0;
 };
 
 // How CHOLMOD organizes the factor. Simplicial: fast for sparse factors and

@@ -299,7 +299,64 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
   return true;
 }
 
-void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
+bool Staircase::CertificateTestArithmetic(double eta,
+                                          ProofPrecision* precision) const {
+  *precision = ProofPrecision::kDouble;
+  if (options_.proof_arithmetic ==
+      SolverOptions::ProofArithmetic::kDoubleDouble) {
+    *precision = ProofPrecision::kDoubleDouble;
+  } else if (1.5 * certificate_->next_double_shift() * translation_spread_ >
+             eta) {
+    // Double cannot prove a shift this small here (see Verify()).
+    if (options_.proof_arithmetic == SolverOptions::ProofArithmetic::kDouble) {
+      return false;
+    }
+    *precision = ProofPrecision::kDoubleDouble;
+  }
+  return true;
+}
+
+bool Staircase::TestCertificate(double eta, ProofPrecision precision,
+                                SolverSummary::Level* level) {
+  const Clock::time_point deadline = Deadline();
+  if (deadline != Clock::time_point::max() &&
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(
+                             certificate_->PredictedSeconds(precision))) >
+          deadline) {
+    return false;
+  }
+  const int double_before = certificate_->double_factorizations();
+  const int extended_before = certificate_->extended_factorizations();
+  const double extended_time_before = certificate_->extended_time_s();
+  certificate_->set_deadline(deadline);
+  const bool passed = certificate_->Prove(cost_->Lambda(), eta, precision);
+  if (passed) {
+    passed_test_lambda_ = cost_->Lambda();
+    passed_test_shift_ = certificate_->proven_shift();
+    passed_test_precision_ = precision;
+  }
+  // Verify() factorizes again; only the symbolic analysis is kept meanwhile.
+  certificate_->ReleaseFactor();
+  ++level->certificate_tests;
+  level->factorizations +=
+      certificate_->double_factorizations() - double_before;
+  level->extended_factorizations +=
+      certificate_->extended_factorizations() - extended_before;
+  summary_->extended_proof_time_s +=
+      certificate_->extended_time_s() - extended_time_before;
+  if (options_.verbose) {
+    LOG(INFO) << "rank " << level->rank << ": certificate test at eta " << eta
+              << " (factorization ~"
+              << certificate_->FactorizationCostInSolves(level->rank)
+              << " products' solves)"
+              << " (" << ProofPrecisionName(precision) << ") "
+              << (passed ? "passed" : "failed");
+  }
+  return passed;
+}
+
+void Staircase::Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
                          SolverSummary::Level* level) {
   SESyncCost& cost = *cost_;
   // The gradient tolerance is relative to the final F, so repeat (cheaply,
@@ -318,13 +375,47 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
     level->termination = ceres_summary.termination;
   }
   RiemannianTrustRegionOptions rtr = TrustRegionOptions(options_);
+  // Certificate tests (options_.test_certificate_after_escape), scheduled
+  // in Hessian-vector products (not in time, so that results do not depend
+  // on the machine's speed or load): the level's so far and at the last
+  // test; and the tests' seconds.
+  const bool test_certificate =
+      after_escape && options_.test_certificate_after_escape && !use_ceres;
+  int level_products = 0, last_test_products = 0;
+  double test_seconds = 0;
   rtr.callback = [&](int it, double f, double g, double radius, int inner) {
     if (options_.verbose) {
       LOG(INFO) << "rank " << rank << " iter " << it << " F " << f << " |grad| "
                 << g << " radius " << radius << " tCG " << inner;
     }
     Progress("optimize", rank, level->iterations + it, f, g);
-    return !options_.callback || options_.callback(rank, it, f, g, radius);
+    if (options_.callback && !options_.callback(rank, it, f, g, radius)) {
+      return false;
+    }
+    if (!test_certificate) return true;
+    level_products += inner;
+    const double eta =
+        std::max(options_.min_relative_eta * scale_,
+                 0.5 * options_.certification_max_relative_bound * f /
+                     (static_cast<double>(d_) * n_));
+    ProofPrecision precision;
+    if (!CertificateTestArithmetic(eta, &precision)) return true;
+    // Due when the products since the last test cost at least twice a
+    // factorization (so tests cost at most about half the optimization;
+    // double-double ~2.5x double, measured 1.6-2.0x plus assembly) and
+    // number at least half the level's (a long descent is tested a
+    // logarithmic number of times).
+    const double cost = certificate_->FactorizationCostInSolves(rank) *
+                        (precision == ProofPrecision::kDouble ? 1.0 : 2.5);
+    const int since = level_products - last_test_products;
+    if (since < std::max(2 * cost, 0.5 * level_products)) return true;
+    last_test_products = level_products;
+    const auto test_start = Clock::now();
+    const bool passed = TestCertificate(eta, precision, level);
+    test_seconds +=
+        std::chrono::duration<double>(Clock::now() - test_start).count();
+    level->certificate_test_passed = passed;
+    return !passed;
   };
   for (int pass = 0; pass < 3 && !use_ceres; ++pass) {
     const double floor = 1e-14 * scale_;
@@ -346,7 +437,11 @@ void Staircase::Optimize(int rank, Eigen::MatrixXd* Y,
       break;
     }
   }
-  cost.Evaluate(*Y);  // Make Y current (Lambda at Y).
+  if (level->certificate_test_passed) {
+    level->termination = "certificate test passed";
+  }
+  level->verify_time_s += test_seconds;  // The tests' time is verification.
+  cost.Evaluate(*Y);                     // Make Y current (Lambda at Y).
   if (use_ceres) {
     Eigen::MatrixXd gradient;
     cost.Gradient(&gradient);
@@ -394,6 +489,18 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
       shift(options_.certification_goal_relative_bound);
   verification_options.policy = ToPolicy(options_.proof_arithmetic);
   verification_options.deadline = Deadline();
+  // Below the maximum rank a failed certificate is escaped from, and the
+  // next level's verification replaces its bound: only the witness counts.
+  verification_options.tighten_uncertified = Y.rows() >= options_.max_rank;
+  // A certificate test passed for these very multipliers (the optimization
+  // stopped at its point): its proof stands, and only cheap double proofs
+  // try to tighten it (double-double ones would repeat its cost).
+  if (passed_test_lambda_.size() > 0 &&
+      passed_test_lambda_ == cost_->Lambda()) {
+    verification_options.known_shift = passed_test_shift_;
+    verification_options.known_precision = passed_test_precision_;
+  }
+  passed_test_lambda_.resize(0, 0);
   // The rounded poses cannot be proven closer to the optimum than their
   // rounding gap. When Algorithm 2 applied to Y now (an upper bound on the
   // final gap, before refinement) already misses the goal, the relaxation
@@ -414,8 +521,9 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
       verification_options.likely_optimal = true;
     }
   }
-  verification_options.translation_spread = TranslationSpread(
-      problem_->RecoverTranslations(R), problem_->layout().gauge(), n);
+  translation_spread_ = TranslationSpread(problem_->RecoverTranslations(R),
+                                          problem_->layout().gauge(), n);
+  verification_options.translation_spread = translation_spread_;
   VerificationResult verification = VerifyCertificate(
       *problem_, cost_->Lambda(), verification_options, certificate_.get());
   if (!verification.certified && sdp_value <= zero_objective_) {
@@ -449,13 +557,15 @@ bool Staircase::Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus) {
 void Staircase::Run(Eigen::MatrixXd* Y) {
   AwaitPreconditioner();
   SolverSummary& s = *summary_;
-  for (int r = static_cast<int>(Y->rows());; ++r) {
+  for (int r = static_cast<int>(Y->rows()), first = r;; ++r) {
     SolverSummary::Level level;
     level.rank = r;
     auto t = Clock::now();
-    Optimize(r, Y, &level);
+    Optimize(r, /*after_escape=*/r > first, Y, &level);
+    // Without the certificate tests' time (verify_time_s so far).
     level.optimize_time_s =
-        std::chrono::duration<double>(Clock::now() - t).count();
+        std::chrono::duration<double>(Clock::now() - t).count() -
+        level.verify_time_s;
     // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
     sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
     level.sdp_value = sdp_value_;
@@ -463,21 +573,21 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
     Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
     t = Clock::now();
     verification_ = Verify(*Y, sdp_value_);
-    level.verify_time_s =
+    level.verify_time_s +=
         std::chrono::duration<double>(Clock::now() - t).count();
     level.certified = verification_.certified;
     level.eta = verification_.eta;
     level.lambda_min_estimate = verification_.lambda_min_estimate;
-    level.factorizations = verification_.factorizations;
-    level.extended_factorizations = verification_.extended_factorizations;
+    level.factorizations += verification_.factorizations;
+    level.extended_factorizations += verification_.extended_factorizations;
     // The dual bound of these multipliers (they change when rounding
     // refines the poses).
     lower_bound_ =
         std::isfinite(verification_.eta)
             ? ProvenLowerBound(cost_->Lambda(), d_, verification_.eta)
             : 0.0;
-    s.factorizations += verification_.factorizations;
-    s.extended_factorizations += verification_.extended_factorizations;
+    s.factorizations += level.factorizations;
+    s.extended_factorizations += level.extended_factorizations;
     s.extended_proof_time_s += verification_.extended_time_s;
     s.iterations += level.iterations;
     s.hessian_vector_products += level.hessian_vector_products;

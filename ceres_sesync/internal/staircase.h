@@ -142,8 +142,20 @@ class Staircase {
   double RemainingTime() const;
   // start + max_time_s, or time_point::max() for no limit.
   Clock::time_point Deadline() const;
-  // One level's local optimization (RTR or Ceres LBFGS) from Y.
-  void Optimize(int rank, Eigen::MatrixXd* Y, SolverSummary::Level* level);
+  // One level's local optimization (RTR or Ceres LBFGS) from Y; a level
+  // entered by an escape tests the certificate on the way
+  // (SolverOptions::test_certificate_after_escape).
+  void Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
+                SolverSummary::Level* level);
+  // The arithmetic of a certificate test at shift eta: double where it can
+  // succeed (above the double floor of the last verification), else
+  // double-double; false if the options allow neither.
+  bool CertificateTestArithmetic(double eta, ProofPrecision* precision) const;
+  // One certificate test at the current point of the cost: tries to prove
+  // S + eta I >= 0 (not started if predicted to end after the time limit).
+  // Adds its factorizations to `level`; true iff it proved it.
+  bool TestCertificate(double eta, ProofPrecision precision,
+                       SolverSummary::Level* level);
   // The deferred double-double proof (see Report()).
   void TightenProof(const Eigen::MatrixXd& Y, double objective);
   // Escapes the saddle at rank r along the verification's direction; false
@@ -171,6 +183,14 @@ class Staircase {
   double lower_bound_ = 0;  // Proven at the last verification.
   // The last verification skipped double-double (not exact: see Verify()).
   bool extended_deferred_ = false;
+  // The last verification's translation spread (VerificationOptions), for
+  // the certificate tests' choice of arithmetic.
+  double translation_spread_ = 0;
+  // A certificate test that passed (the optimization stopped there): its
+  // Lambda, proven shift and arithmetic, for the level's verification.
+  Eigen::MatrixXd passed_test_lambda_;
+  double passed_test_shift_ = 0;
+  ProofPrecision passed_test_precision_ = ProofPrecision::kDouble;
 };
 
 // The solution from rotations R (d x dn) and translations T (d x N) in the

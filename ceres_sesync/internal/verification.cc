@@ -267,6 +267,34 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       matrix->next_double_shift() * options.translation_spread;
   VLOG(1) << "verification: double floor " << double_floor << " (target "
           << eta_target << ", goal " << goal << ", max " << eta_max << ")";
+  if (std::isfinite(options.known_shift)) {
+    // Proven already (VerificationOptions::known_shift). Where double can
+    // prove smaller shifts, tighten as in step 3: a factor at the known
+    // shift, the Lanczos estimate of lambda_min(S), double proofs from just
+    // above it up by 8, and, if they stop short of a 4x tighter shift that
+    // the estimate allows (double's floor), one double-double proof there.
+    result.eta = options.known_shift;
+    result.precision = options.known_precision;
+    const double start = std::max(
+        {eta_target, 1.5 * double_floor, std::numeric_limits<double>::min()});
+    if (first == ProofPrecision::kDouble && start < result.eta &&
+        fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
+        matrix->Factorize(Lambda, result.eta)) {
+      const double lambda_min = estimate_lambda_min(result.eta);
+      result.lambda_min_estimate = lambda_min;
+      const double tight = std::isfinite(lambda_min)
+                               ? std::max(eta_target, -1.1 * lambda_min)
+                               : std::numeric_limits<double>::infinity();
+      for (double c = std::max(start, std::min(tight, result.eta));
+           c < result.eta && !result.out_of_time; c *= 8) {
+        if (prove(c, ProofPrecision::kDouble)) break;
+      }
+      if (use_extended && tight < result.eta / 4 && !result.out_of_time) {
+        prove(tight, ProofPrecision::kDoubleDouble);
+      }
+    }
+    return finish();
+  }
   if (first == ProofPrecision::kDoubleDouble) {
     if (prove(eta_target, first) && result.eta <= goal) return finish();
   } else if (double_floor <= goal / 4 || !use_extended) {
@@ -396,7 +424,8 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     }
     // Tighten the shift to just above the estimate, unless the bound stays
     // vacuous there too (a shift >= c_vacuous bounds F by at most 0).
-    if (std::isfinite(result.lambda_min_estimate)) {
+    if (options.tighten_uncertified &&
+        std::isfinite(result.lambda_min_estimate)) {
       const double tight =
           std::max(eta_target, -1.05 * result.lambda_min_estimate);
       if (tight < factor_shift && tight < c_vacuous) {

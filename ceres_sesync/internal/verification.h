@@ -6,6 +6,7 @@
 #define CERES_SESYNC_INTERNAL_VERIFICATION_H_
 
 #include <chrono>
+#include <limits>
 
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/sesync_problem.h"
@@ -45,6 +46,18 @@ struct VerificationOptions {
   // it plus a double one; a candidate that is not near-optimal costs one failed
   // double-double factorization more (1.6-1.7x a double one, measured).
   bool likely_optimal = false;
+  // When not certified: prove a last shift just above the Lanczos estimate
+  // of lambda_min(S) (one more factorization), so that eta and its lower
+  // bound are near what lambda_min allows instead of at the witness's
+  // shift. A caller that only needs the witness (the staircase escaping to
+  // the next rank, whose own verification replaces this bound) sets false.
+  bool tighten_uncertified = true;
+  // S + known_shift I was proven already for this Lambda, in
+  // known_precision (a certificate test during the optimization: see
+  // SolverOptions::test_certificate_after_escape). The result starts from
+  // it, and only the fast path's double proofs (cheap) try to improve on it.
+  double known_shift = std::numeric_limits<double>::infinity();
+  ProofPrecision known_precision = ProofPrecision::kDouble;
   // No factorization is started that is predicted to end after this
   // (CertificateMatrix::PredictedSeconds), double-double ones stop at it,
   // and nothing starts once it has passed; the result then has out_of_time
@@ -93,7 +106,10 @@ Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
                                     const Eigen::VectorXd& v);
 
 // Proves the smallest shift it can (a complete proof, CertificateMatrix::
-// Prove):
+// Prove). With a known shift (VerificationOptions::known_shift) only a
+// tightening as in step 3 runs, where double can reach below it (at most one
+// double-double proof, at the Lanczos estimate, when that is 4x tighter).
+// Otherwise:
 //  1. a proof at eta_target, then in double at eta_goal / 4; done if one
 //     proves a shift <= the goal;
 //  2. one factorization (no proof) at eta_max tells a near-optimal Lambda

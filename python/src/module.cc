@@ -200,6 +200,7 @@ void BindSolverOptions(py::module_& m) {
       .rw("certification_max_rounding_gap", &O::certification_max_rounding_gap)
       .rw("min_relative_eta", &O::min_relative_eta)
       .rw("refine_rounded_solution", &O::refine_rounded_solution)
+      .rw("test_certificate_after_escape", &O::test_certificate_after_escape)
       .rw("num_threads", &O::num_threads)
       .rw("max_time_s", &O::max_time_s)
       .rw("verbose", &O::verbose)
@@ -230,7 +231,9 @@ void BindSolverSummary(py::module_& m) {
       .ro("optimize_time_s", &S::Level::optimize_time_s)
       .ro("verify_time_s", &S::Level::verify_time_s)
       .ro("factorizations", &S::Level::factorizations)
-      .ro("extended_factorizations", &S::Level::extended_factorizations);
+      .ro("extended_factorizations", &S::Level::extended_factorizations)
+      .ro("certificate_tests", &S::Level::certificate_tests)
+      .ro("certificate_test_passed", &S::Level::certificate_test_passed);
   Fields(cls)
       .get("status", [](const S& s) { return s.StatusString(); })
       .ro("message", &S::message)
