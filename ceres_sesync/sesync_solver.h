@@ -271,12 +271,15 @@ struct SolverSummary {
   int final_rank = 0;
   int iterations = 0;
   int hessian_vector_products = 0;
-  // Cholesky factorizations of the certificate matrix in verification, in
-  // double and in double-double, and the seconds the latter took (part of
-  // verification_time_s).
+  // Cholesky factorizations of the certificate matrix in verification
+  // (certificate tests included), in double and in double-double, and the
+  // seconds the latter took (part of verification_time_s).
   int factorizations = 0;
   int extended_factorizations = 0;
   double extended_proof_time_s = 0;
+  // Certificate tests during the descents after saddle escapes (the sum of
+  // the levels'; test_certificate_after_escape).
+  int certificate_tests = 0;
   std::vector<Level> levels;
   // Wall-clock seconds per stage.
   double data_time_s = 0, initialization_time_s = 0, optimization_time_s = 0,

@@ -509,6 +509,8 @@ TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
   EXPECT_EQ(s_on.levels[0].sdp_value, s_off.levels[0].sdp_value);
   const SolverSummary::Level& tested = s_on.levels[1];
   EXPECT_GE(tested.certificate_tests, 1);
+  EXPECT_EQ(s_on.certificate_tests, tested.certificate_tests);
+  EXPECT_EQ(s_off.certificate_tests, 0);
   EXPECT_TRUE(tested.certificate_test_passed);
   EXPECT_EQ(tested.termination, "certificate test passed");
   EXPECT_TRUE(tested.certified);

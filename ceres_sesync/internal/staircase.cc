@@ -493,8 +493,8 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
   // next level's verification replaces its bound: only the witness counts.
   verification_options.tighten_uncertified = Y.rows() >= options_.max_rank;
   // A certificate test passed for these very multipliers (the optimization
-  // stopped at its point): its proof stands, and only cheap double proofs
-  // try to tighten it (double-double ones would repeat its cost).
+  // stopped at its point): its proof stands, and is only tightened where
+  // double reaches below it (VerificationOptions::known_shift).
   if (passed_test_lambda_.size() > 0 &&
       passed_test_lambda_ == cost_->Lambda()) {
     verification_options.known_shift = passed_test_shift_;
@@ -588,6 +588,7 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
             : 0.0;
     s.factorizations += level.factorizations;
     s.extended_factorizations += level.extended_factorizations;
+    s.certificate_tests += level.certificate_tests;
     s.extended_proof_time_s += verification_.extended_time_s;
     s.iterations += level.iterations;
     s.hessian_vector_products += level.hessian_vector_products;

@@ -55,7 +55,9 @@ struct VerificationOptions {
   // S + known_shift I was proven already for this Lambda, in
   // known_precision (a certificate test during the optimization: see
   // SolverOptions::test_certificate_after_escape). The result starts from
-  // it, and only the fast path's double proofs (cheap) try to improve on it.
+  // it, and only VerifyCertificate's known-shift tightening tries to improve
+  // on it (no double-double proof repeats the test's cost unless double
+  // stops 4x short of the Lanczos estimate).
   double known_shift = std::numeric_limits<double>::infinity();
   ProofPrecision known_precision = ProofPrecision::kDouble;
   // No factorization is started that is predicted to end after this

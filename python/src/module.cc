@@ -258,6 +258,7 @@ void BindSolverSummary(py::module_& m) {
       .ro("hessian_vector_products", &S::hessian_vector_products)
       .ro("factorizations", &S::factorizations)
       .ro("extended_factorizations", &S::extended_factorizations)
+      .ro("certificate_tests", &S::certificate_tests)
       .ro("extended_proof_time_s", &S::extended_proof_time_s)
       .ro("levels", &S::levels)
       .ro("data_time_s", &S::data_time_s)
