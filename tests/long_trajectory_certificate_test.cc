@@ -298,6 +298,36 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
           << "FALSE CERTIFICATE at eta " << h.eta;
     }
   }
+
+  // A lifted saddle behind the hint, as the staircase meets them on large
+  // maps (a 10^6-pose city: lambda_min(S) = -3 eta_max, eta_max above
+  // double's floor): multipliers raised to lambda_min(S') = -4 eta_max.
+  // After the failed double-double proof the witness comes from the
+  // ladder's first shift, 16 eta_max, proven in double with no
+  // near-optimality test (a factorization at eta_max) and no poor-candidate
+  // test (one at tr(Lambda) / dn) before it; then one proof just above the
+  // Lanczos estimate (tighten_uncertified). Those two tests would be two
+  // factorizations more.
+  internal::CertificateMatrix saddle_matrix(problem);
+  internal::VerificationOptions saddle = hinted;
+  saddle.eta_max =
+      std::max(options.eta_max, 8 * saddle_matrix.next_double_shift() * spread);
+  Eigen::MatrixXd raised = Lambda;
+  for (int i = 0; i < c.n; ++i) {
+    raised.middleCols(c.d * i, c.d) +=
+        (4 * saddle.eta_max + true_shift) * Eigen::MatrixXd::Identity(c.d, c.d);
+  }
+  const internal::VerificationResult s =
+      internal::VerifyCertificate(problem, raised, saddle, &saddle_matrix);
+  EXPECT_FALSE(s.certified);
+  EXPECT_FALSE(s.vacuous_bound);
+  EXPECT_LT(s.direction_curvature, -saddle.eta_max);
+  EXPECT_EQ(s.extended_factorizations, 1);
+  EXPECT_EQ(s.factorizations, 2);
+  ASSERT_TRUE(std::isfinite(s.eta));
+  EXPECT_EQ(reference.NegativePivots(raised, s.eta), 0)
+      << "FALSE CERTIFICATE at eta " << s.eta;
+  EXPECT_LT(s.eta, 16 * saddle.eta_max);  // Tightened below the witness's.
 }
 
 INSTANTIATE_TEST_SUITE_P(Corridors, LongTrajectoryCertificate,

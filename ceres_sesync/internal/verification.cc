@@ -258,6 +258,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     attempt(eta_max);
   };
 
+  bool suspect_saddle = false;  // See the likely_optimal branch below.
   // 1. The fast path: a proof at the target shift, then in double one at a
   // quarter of the goal (where double suffices, e.g. compact 3D maps, that
   // is all it takes). Double proofs below the cost of their translation
@@ -308,6 +309,13 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     // Double cannot reach the goal; a probably optimal candidate goes to
     // double-double directly (see VerificationOptions::likely_optimal).
     if (attempt(goal / 16) && result.eta <= goal) return finish();
+    // Failed: lambda_min(S) < -goal / 16. Usually a lifted saddle of rank
+    // d (rounding loses nothing there either), whose witness step 4 finds:
+    // the near-optimality test of step 2 is skipped. A near-optimal
+    // candidate is recognized after step 4 instead, by the witness's
+    // curvature, and its double-double proofs then step up by 8 from the
+    // goal (without step 2's Lanczos estimate).
+    suspect_saddle = !(result.eta <= eta_max);
   }
 
   // 2. Near-optimal (lambda_min(S) > -eta_max up to round-off) or not?
@@ -315,7 +323,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   if (result.out_of_time) return finish();
   // The double factor is that of S + eta_max I (no proof since).
   bool factor_at_eta_max = false;
-  if (!near_optimal && eta_max > eta_target &&
+  if (!near_optimal && !suspect_saddle && eta_max > eta_target &&
       fits(matrix->PredictedSeconds(ProofPrecision::kDouble))) {
     near_optimal = factor_at_eta_max = matrix->Factorize(Lambda, eta_max);
   }
@@ -360,7 +368,21 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   double factor_shift = 0;  // The smallest shift proven here.
   bool proven = false;
   bool factor_is_current = false;  // The double factor is that at factor_shift.
-  if (c_vacuous > c && c_vacuous < c_upper) {
+  bool first_rung = false;  // Proven here, before the poor-candidate test.
+  if (suspect_saddle && 16 * c < std::min(c_vacuous, c_upper)) {
+    // The ladder's first shift before the poor-candidate test: a saddle's
+    // negative curvature is usually mild (a 10^5-pose city: lambda_min(S) =
+    // -3 eta_max), so this proof is the one the ladder ends at, and the
+    // test's factorization is saved; a poor candidate pays one failed
+    // factorization more.
+    if (prove(16 * c, ProofPrecision::kDouble)) {
+      proven = factor_is_current = first_rung = true;
+      factor_shift = 16 * c;
+    }
+    if (result.out_of_time) return finish();
+    c *= 16;  // The ladder goes on above it.
+  }
+  if (!proven && c_vacuous > c && c_vacuous < c_upper) {
     if (prove(c_vacuous, ProofPrecision::kDouble)) {
       c_upper = c_vacuous;
       proven = factor_is_current = true;
@@ -375,7 +397,8 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       c = c_vacuous;
     }
   }
-  for (int step = 0; c < c_upper && !result.out_of_time; ++step) {
+  for (int step = 0; !first_rung && c < c_upper && !result.out_of_time;
+       ++step) {
     if (step == 2 && matrix->supernodal() && !result.vacuous_bound && fits(0) &&
         lanczos_is_cheap()) {
       // lambda_min(S) < -256 max(eta_target, eta_max): usually clear

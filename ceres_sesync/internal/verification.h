@@ -44,7 +44,11 @@ struct VerificationOptions {
   // factorization at eta_max), which is needed only if that proof fails. A
   // certified large map then takes one double-double factorization instead of
   // it plus a double one; a candidate that is not near-optimal costs one failed
-  // double-double factorization more (1.6-1.7x a double one, measured).
+  // double-double factorization more (1.6-1.7x a double one, measured). When
+  // that proof fails, the candidate is taken for a lifted saddle: the
+  // near-optimality test is skipped, and the witness's ladder proves its
+  // first shift (16 eta_max) before the poor-candidate test (two
+  // factorizations fewer for a saddle; one more for a poor candidate).
   bool likely_optimal = false;
   // When not certified: prove a last shift just above the Lanczos estimate
   // of lambda_min(S) (one more factorization), so that eta and its lower
@@ -116,7 +120,8 @@ Eigen::VectorXd MultiplyCertificate(const SESyncProblem& problem,
 //     proves a shift <= the goal;
 //  2. one factorization (no proof) at eta_max tells a near-optimal Lambda
 //     (it succeeds: lambda_min(S) > -eta_max up to double round-off) from a
-//     saddle or poor candidate;
+//     saddle or poor candidate (skipped after a failed likely_optimal
+//     proof, where step 4 starts with its ladder's first shift);
 //  3. near-optimal: proofs at eta_goal / 16 and eta_goal, then (when they
 //     fail) at shifts guided by a shift-and-invert Lanczos estimate of
 //     lambda_min(S) from the factor at eta_max, then by factors of 8 up to
