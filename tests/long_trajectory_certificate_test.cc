@@ -266,13 +266,18 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   // lambda_min(S) - delta. Within the goal (delta = goal / 2) the proof must
   // still certify (tightness); beyond it (4 goal) it must not (soundness);
   // and every shift it proves must make S' + eta I PSD in binary128.
-  for (double factor : {0.5, 4.0}) {
-    const double delta = factor * options.eta_goal + true_shift;
+  // Lambda + delta I, block by block.
+  auto raise = [&](double delta) {
     Eigen::MatrixXd raised = Lambda;
     for (int i = 0; i < c.n; ++i) {
       raised.middleCols(c.d * i, c.d) +=
           delta * Eigen::MatrixXd::Identity(c.d, c.d);
     }
+    return raised;
+  };
+  for (double factor : {0.5, 4.0}) {
+    const Eigen::MatrixXd raised =
+        raise(factor * options.eta_goal + true_shift);
     internal::VerificationOptions limit = options;
     limit.eta_max = limit.eta_goal = options.eta_goal;
     const internal::VerificationResult w =
@@ -312,11 +317,7 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   internal::VerificationOptions saddle = hinted;
   saddle.eta_max =
       std::max(options.eta_max, 8 * saddle_matrix.next_double_shift() * spread);
-  Eigen::MatrixXd raised = Lambda;
-  for (int i = 0; i < c.n; ++i) {
-    raised.middleCols(c.d * i, c.d) +=
-        (4 * saddle.eta_max + true_shift) * Eigen::MatrixXd::Identity(c.d, c.d);
-  }
+  const Eigen::MatrixXd raised = raise(4 * saddle.eta_max + true_shift);
   const internal::VerificationResult s =
       internal::VerifyCertificate(problem, raised, saddle, &saddle_matrix);
   EXPECT_FALSE(s.certified);

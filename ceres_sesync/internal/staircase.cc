@@ -299,6 +299,11 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
   return true;
 }
 
+double Staircase::Shift(double relative_bound, double sdp_value) const {
+  return std::max(options_.min_relative_eta * scale_,
+                  relative_bound * sdp_value / (static_cast<double>(d_) * n_));
+}
+
 bool Staircase::CertificateTestArithmetic(double eta,
                                           ProofPrecision* precision) const {
   *precision = ProofPrecision::kDouble;
@@ -395,9 +400,7 @@ void Staircase::Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
     if (!test_certificate) return true;
     level_products += inner;
     const double eta =
-        std::max(options_.min_relative_eta * scale_,
-                 0.5 * options_.certification_max_relative_bound * f /
-                     (static_cast<double>(d_) * n_));
+        Shift(0.5 * options_.certification_max_relative_bound, f);
     ProofPrecision precision;
     if (!CertificateTestArithmetic(eta, &precision)) return true;
     // Due when the products since the last test cost at least twice a
@@ -476,17 +479,13 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
                                      double sdp_value) {
   AwaitPreconditioner();
   const int d = d_, n = n_;
-  const double eta_floor = options_.min_relative_eta * scale_;
-  auto shift = [&](double relative_bound) {
-    return std::max(eta_floor, relative_bound * sdp_value / (d * n));
-  };
   VerificationOptions verification_options;
   verification_options.eta_target =
-      shift(options_.certification_target_relative_bound);
+      Shift(options_.certification_target_relative_bound, sdp_value);
   verification_options.eta_max =
-      shift(options_.certification_max_relative_bound);
+      Shift(options_.certification_max_relative_bound, sdp_value);
   verification_options.eta_goal =
-      shift(options_.certification_goal_relative_bound);
+      Shift(options_.certification_goal_relative_bound, sdp_value);
   verification_options.policy = ToPolicy(options_.proof_arithmetic);
   verification_options.deadline = Deadline();
   // Below the maximum rank a failed certificate is escaped from, and the
@@ -678,8 +677,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
   cost_->Evaluate(Y);  // Lambda at Y again (rounding moved the cost).
   VerificationOptions o;
   o.eta_target =
-      std::max(options_.min_relative_eta * scale_,
-               options_.certification_target_relative_bound * sdp_value_ / dn);
+      Shift(options_.certification_target_relative_bound, sdp_value_);
   o.eta_max = eta_max;
   o.eta_goal = eta_max / 4;
   o.policy = ProofPolicy::kDoubleDouble;

@@ -147,6 +147,9 @@ class Staircase {
   // (SolverOptions::test_certificate_after_escape).
   void Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
                 SolverSummary::Level* level);
+  // The shift of a relative bound on the objective: relative_bound *
+  // sdp_value / (d n), at least min_relative_eta's floor.
+  double Shift(double relative_bound, double sdp_value) const;
   // The arithmetic of a certificate test at shift eta: double where it can
   // succeed (above the double floor of the last verification), else
   // double-double; false if the options allow neither.

@@ -368,7 +368,6 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   double factor_shift = 0;  // The smallest shift proven here.
   bool proven = false;
   bool factor_is_current = false;  // The double factor is that at factor_shift.
-  bool first_rung = false;  // Proven here, before the poor-candidate test.
   if (suspect_saddle && 16 * c < std::min(c_vacuous, c_upper)) {
     // The ladder's first shift before the poor-candidate test: a saddle's
     // negative curvature is usually mild (a 10^5-pose city: lambda_min(S) =
@@ -376,11 +375,11 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     // test's factorization is saved; a poor candidate pays one failed
     // factorization more.
     if (prove(16 * c, ProofPrecision::kDouble)) {
-      proven = factor_is_current = first_rung = true;
+      proven = factor_is_current = true;
       factor_shift = 16 * c;
     }
     if (result.out_of_time) return finish();
-    c *= 16;  // The ladder goes on above it.
+    c *= 16;  // If it failed, the ladder goes on above it.
   }
   if (!proven && c_vacuous > c && c_vacuous < c_upper) {
     if (prove(c_vacuous, ProofPrecision::kDouble)) {
@@ -397,8 +396,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       c = c_vacuous;
     }
   }
-  for (int step = 0; !first_rung && c < c_upper && !result.out_of_time;
-       ++step) {
+  for (int step = 0; c < c_upper && !result.out_of_time; ++step) {
     if (step == 2 && matrix->supernodal() && !result.vacuous_bound && fits(0) &&
         lanczos_is_cheap()) {
       // lambda_min(S) < -256 max(eta_target, eta_max): usually clear
@@ -414,7 +412,8 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       }
     }
     c = std::min(16 * std::max(c, std::numeric_limits<double>::min()), c_upper);
-    if (proven && c >= factor_shift) break;  // c_vacuous is proven already.
+    // c_vacuous (or the saddle's first shift) is proven already.
+    if (proven && c >= factor_shift) break;
     factor_is_current = prove(c, ProofPrecision::kDouble);
     if (factor_is_current) {
       proven = true;
