@@ -225,6 +225,7 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
   }
   if (o.max_iterations < 0) return "max_iterations must be >= 0";
   if (o.initial_max_rank < 0) return "initial_max_rank must be >= 0";
+  if (o.gnc_max_rank < 0) return "gnc_max_rank must be >= 0";
   if (!(o.gnc_relative_gradient_tolerance >= 0) ||
       !std::isfinite(o.gnc_relative_gradient_tolerance)) {
     return "gnc_relative_gradient_tolerance must be a finite number >= 0";
@@ -335,9 +336,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
 
   // The first solve is Solve() itself up to initial_max_rank. GNC's
   // weighted solves then stop their local searches at
-  // gnc_relative_gradient_tolerance and prove their certificates in double
-  // only (they decide saddle escapes; no bound of theirs is reported); each
-  // final inlier problem is solved with the caller's options again. The
+  // gnc_relative_gradient_tolerance, prove their certificates in double
+  // only (they decide saddle escapes; no bound of theirs is reported) and
+  // climb to gnc_max_rank, with no certificate test there; each final
+  // inlier problem is solved with the caller's options again. The
   // Staircase reads its options at every stage.
   SolverOptions solve_options = options.solver_options;
   const int r0 = options.solver_options.initial_rank > 0
@@ -458,6 +460,9 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       solve_options.relative_preconditioned_gradient_tolerance =
           options.gnc_relative_gradient_tolerance;
     }
+    solve_options.max_rank = std::min(
+        options.solver_options.max_rank,
+        options.gnc_max_rank > 0 ? std::max(options.gnc_max_rank, r0) : r0 + 2);
     for (int it = 0; it < options.max_iterations; ++it) {
       const auto step_start = Clock::now();
       MeasurementWeights next(m);
@@ -472,7 +477,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       }
       run.weights = std::move(next);
       Y = ReduceRank(Y, d, r0, kRankTolerance);
-      problem.staircase().Run(&Y);
+      problem.staircase().Run(&Y, /*verify_at_max_rank=*/false);
       run.poses = problem.staircase().Round(Y).poses;
       reported = false;
       f = Costs(graph, run.poses);

@@ -225,6 +225,74 @@ TEST(RobustSolver, InlierProblemIsSolvedWithTheCallersOptions) {
   }
 }
 
+// The GNC steps' staircase climbs at most to gnc_max_rank and skips the
+// certificate test there (GNC uses only the step's poses; a test at the top
+// rank has nothing to escape to). The final inlier problem keeps the
+// caller's ranks and is certified as before.
+TEST(RobustSolver, GncStepsStopAtGncMaxRankWithoutTheTopCertificateTest) {
+  for (int d : {2, 3}) {
+    PoseGraph corrupted;
+    std::vector<int> added;
+    ASSERT_TRUE(NoisyChainWithOutliers(d, &corrupted, &added));
+    const int r0 = d + 2;
+    // Capped at r0: every step is one level at r0 with no certificate test.
+    RobustSolverOptions options = Options();
+    options.gnc_max_rank = r0;
+    RobustSolverSummary s;
+    SolveRobust(corrupted, options, &s);
+    ASSERT_EQ(s.status, RobustSolverSummary::Status::kConverged)
+        << s.FullReport();
+    ASSERT_GT(s.history.size(), 0u);
+    for (const RobustSolverSummary::Iteration& step : s.history) {
+      EXPECT_EQ(step.rank, r0);
+      EXPECT_EQ(step.status, SolverSummary::Status::kMaxRankReached);
+      EXPECT_EQ(step.verification_time_s, 0.0);
+    }
+    EXPECT_TRUE(s.certified()) << s.FullReport();
+    EXPECT_EQ(s.outlier_edges, added) << s.FullReport();
+    // Default: at most r0 + 2.
+    SolveRobust(corrupted, Options(), &s);
+    for (const RobustSolverSummary::Iteration& step : s.history) {
+      EXPECT_LE(step.rank, r0 + 2);
+    }
+    EXPECT_EQ(s.outlier_edges, added) << s.FullReport();
+  }
+}
+
+// Staircase::Run without the test at max_rank: the level is optimized as
+// usual (the same factor as with the test) but neither factorized nor
+// bounded; with the test, the same point is certified.
+TEST(RobustSolver, StaircaseCanSkipTheCertificateTestAtMaxRank) {
+  for (int d : {2, 3}) {
+    const PoseGraph graph = ChainGraph(d, 30, 20, false, 5, nullptr);
+    SolverOptions options;
+    options.num_threads = 1;
+    options.max_rank = d + 2;
+    SolverSummary skipped, tested;
+    internal::Staircase a(graph, options, &skipped,
+                          internal::Staircase::Clock::now());
+    internal::Staircase b(graph, options, &tested,
+                          internal::Staircase::Clock::now());
+    ASSERT_TRUE(a.ok() && b.ok());
+    Eigen::MatrixXd Ya, Yb;
+    ASSERT_TRUE(a.Initialize(nullptr, &Ya));
+    ASSERT_TRUE(b.Initialize(nullptr, &Yb));
+    a.Run(&Ya, /*verify_at_max_rank=*/false);
+    b.Run(&Yb);
+    EXPECT_EQ(skipped.status, SolverSummary::Status::kMaxRankReached);
+    ASSERT_EQ(skipped.levels.size(), 1u);
+    EXPECT_EQ(skipped.levels[0].factorizations, 0);
+    EXPECT_EQ(skipped.factorizations + skipped.extended_factorizations, 0);
+    EXPECT_FALSE(skipped.levels[0].certified);
+    EXPECT_TRUE(std::isinf(skipped.levels[0].eta));
+    EXPECT_EQ(skipped.verification_time_s, 0.0);
+    EXPECT_FALSE(a.verification().certified);
+    EXPECT_EQ(tested.status, SolverSummary::Status::kCertifiedOptimum);
+    EXPECT_GT(tested.factorizations + tested.extended_factorizations, 0);
+    EXPECT_EQ(Ya, Yb);
+  }
+}
+
 // A 3 x 3 x 3 cube at the paper's noise (kappa 16.67, tau 75) plus random
 // wrong closures at 30% (cube and outlier seed `seed`).
 bool SmallNoisyCubeWithOutliers(uint64_t seed, PoseGraph* corrupted,

@@ -553,7 +553,7 @@ bool Staircase::Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus) {
   return false;
 }
 
-void Staircase::Run(Eigen::MatrixXd* Y) {
+void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
   AwaitPreconditioner();
   SolverSummary& s = *summary_;
   for (int r = static_cast<int>(Y->rows()), first = r;; ++r) {
@@ -568,6 +568,22 @@ void Staircase::Run(Eigen::MatrixXd* Y) {
     // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
     sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
     level.sdp_value = sdp_value_;
+    if (!verify_at_max_rank && r >= options_.max_rank) {
+      verification_ = VerificationResult();
+      verification_.eta = std::numeric_limits<double>::infinity();
+      verification_.lambda_min_estimate =
+          std::numeric_limits<double>::quiet_NaN();
+      level.eta = verification_.eta;
+      level.lambda_min_estimate = verification_.lambda_min_estimate;
+      lower_bound_ = 0;
+      s.iterations += level.iterations;
+      s.hessian_vector_products += level.hessian_vector_products;
+      s.optimization_time_s += level.optimize_time_s;
+      s.levels.push_back(level);
+      s.final_rank = r;
+      s.status = SolverSummary::Status::kMaxRankReached;
+      return;
+    }
 
     Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
     t = Clock::now();

@@ -98,7 +98,10 @@ class Staircase {
   // Stage "staircase": from Y (any rank >= d + 1), optimize, verify, and
   // escape saddles rank by rank until certified or stopped (the summary's
   // status). On return Y is the final factor and the cost is evaluated there.
-  void Run(Eigen::MatrixXd* Y);
+  // With verify_at_max_rank false, a level at options.max_rank ends with
+  // kMaxRankReached without its certificate test (no bound, nothing to
+  // escape to): for callers that use only Y, such as GNC's weighted steps.
+  void Run(Eigen::MatrixXd* Y, bool verify_at_max_rank = true);
 
   // Stage "verify", for the current point Y of the cost (Lambda at Y) with
   // F(Y) = sdp_value: proves S + eta I positive semidefinite for the smallest

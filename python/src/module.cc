@@ -982,6 +982,7 @@ void BindRobust(py::module_& m) {
       .rw("inlier_probability", &O::inlier_probability)
       .rw("gnc_threshold_fractions", &O::gnc_threshold_fractions)
       .rw("initial_max_rank", &O::initial_max_rank)
+      .rw("gnc_max_rank", &O::gnc_max_rank)
       .rw("gnc_relative_gradient_tolerance",
           &O::gnc_relative_gradient_tolerance)
       .rw("mu_step", &O::mu_step)
