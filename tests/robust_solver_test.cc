@@ -293,6 +293,68 @@ TEST(RobustSolver, StaircaseCanSkipTheCertificateTestAtMaxRank) {
   }
 }
 
+// The same for a top level entered by an escape: no certificate test
+// during its optimization either (SolverOptions::
+// test_certificate_after_escape), and the same factor. Rank d + 1 from a
+// random start, then d + 2; the seed is the first of 40 whose escape
+// level tests its certificate on the way when allowed to.
+TEST(RobustSolver, StaircaseSkipsTheTestsDuringATopLevelEnteredByAnEscape) {
+  for (int d : {2, 3}) {
+    RandomGraphOptions g;
+    g.dimension = d;
+    // (Noise at which rank d + 1 from a random start often stalls.)
+    g.num_poses = 60;
+    g.num_loop_closures = 60;
+    g.chain = true;
+    g.noiseless = false;
+    g.kappa = d == 2 ? 1 : 2;
+    g.tau = 10;
+    g.seed = 9;
+    const PoseGraph graph = test_util::RandomPoseGraph(g, nullptr);
+    SolverOptions options;
+    options.num_threads = 1;
+    options.initialization = SolverOptions::Initialization::kRandom;
+    options.initial_rank = d + 1;
+    options.max_rank = d + 2;
+    bool found = false;
+    for (uint64_t seed = 0; seed < 40 && !found; ++seed) {
+      options.seed = seed;
+      SolverSummary tested, skipped;
+      internal::Staircase b(graph, options, &tested,
+                            internal::Staircase::Clock::now());
+      ASSERT_TRUE(b.ok());
+      Eigen::MatrixXd Yb;
+      ASSERT_TRUE(b.Initialize(nullptr, &Yb));
+      b.Run(&Yb);
+      if (tested.levels.size() != 2 ||
+          tested.levels[1].certificate_tests == 0) {
+        continue;
+      }
+      found = true;
+      internal::Staircase a(graph, options, &skipped,
+                            internal::Staircase::Clock::now());
+      ASSERT_TRUE(a.ok());
+      Eigen::MatrixXd Ya;
+      ASSERT_TRUE(a.Initialize(nullptr, &Ya));
+      a.Run(&Ya, /*verify_at_max_rank=*/false);
+      ASSERT_EQ(skipped.levels.size(), 2u) << "seed " << seed;
+      EXPECT_EQ(skipped.levels[0].factorizations,
+                tested.levels[0].factorizations);
+      EXPECT_EQ(skipped.levels[1].certificate_tests, 0);
+      EXPECT_EQ(skipped.levels[1].factorizations +
+                    skipped.levels[1].extended_factorizations,
+                0);
+      EXPECT_EQ(skipped.status, SolverSummary::Status::kMaxRankReached);
+      // Without the tests the level runs to its gradient tolerance; a
+      // passed test may have stopped it earlier, at a point as good.
+      if (!tested.levels[1].certificate_test_passed) {
+        EXPECT_EQ(Ya, Yb) << "seed " << seed;
+      }
+    }
+    EXPECT_TRUE(found) << "d = " << d;
+  }
+}
+
 // A 3 x 3 x 3 cube at the paper's noise (kappa 16.67, tau 75) plus random
 // wrong closures at 30% (cube and outlier seed `seed`).
 bool SmallNoisyCubeWithOutliers(uint64_t seed, PoseGraph* corrupted,

@@ -361,7 +361,7 @@ bool Staircase::TestCertificate(double eta, ProofPrecision precision,
   return passed;
 }
 
-void Staircase::Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
+void Staircase::Optimize(int rank, bool test_certificate, Eigen::MatrixXd* Y,
                          SolverSummary::Level* level) {
   SESyncCost& cost = *cost_;
   // The gradient tolerance is relative to the final F, so repeat (cheaply,
@@ -384,8 +384,8 @@ void Staircase::Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
   // in Hessian-vector products (not in time, so that results do not depend
   // on the machine's speed or load): the level's so far and at the last
   // test; and the tests' seconds.
-  const bool test_certificate =
-      after_escape && options_.test_certificate_after_escape && !use_ceres;
+  const bool test_during =
+      test_certificate && options_.test_certificate_after_escape && !use_ceres;
   int level_products = 0, last_test_products = 0;
   double test_seconds = 0;
   rtr.callback = [&](int it, double f, double g, double radius, int inner) {
@@ -397,7 +397,7 @@ void Staircase::Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
     if (options_.callback && !options_.callback(rank, it, f, g, radius)) {
       return false;
     }
-    if (!test_certificate) return true;
+    if (!test_during) return true;
     level_products += inner;
     const double eta =
         Shift(0.5 * options_.certification_max_relative_bound, f);
@@ -560,7 +560,10 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     SolverSummary::Level level;
     level.rank = r;
     auto t = Clock::now();
-    Optimize(r, /*after_escape=*/r > first, Y, &level);
+    // Tests on the way only after an escape, and only where the level's
+    // certificate is tested at all.
+    const bool tested = verify_at_max_rank || r < options_.max_rank;
+    Optimize(r, /*test_certificate=*/r > first && tested, Y, &level);
     // Without the certificate tests' time (verify_time_s so far).
     level.optimize_time_s =
         std::chrono::duration<double>(Clock::now() - t).count() -
@@ -568,7 +571,7 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
     sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
     level.sdp_value = sdp_value_;
-    if (!verify_at_max_rank && r >= options_.max_rank) {
+    if (!tested) {
       verification_ = VerificationResult();
       verification_.eta = std::numeric_limits<double>::infinity();
       verification_.lambda_min_estimate =

@@ -99,8 +99,9 @@ class Staircase {
   // escape saddles rank by rank until certified or stopped (the summary's
   // status). On return Y is the final factor and the cost is evaluated there.
   // With verify_at_max_rank false, a level at options.max_rank ends with
-  // kMaxRankReached without its certificate test (no bound, nothing to
-  // escape to): for callers that use only Y, such as GNC's weighted steps.
+  // kMaxRankReached without its certificate test, nor tests during its
+  // optimization (no bound, nothing to escape to): for callers that use
+  // only Y, such as GNC's weighted steps.
   void Run(Eigen::MatrixXd* Y, bool verify_at_max_rank = true);
 
   // Stage "verify", for the current point Y of the cost (Lambda at Y) with
@@ -145,10 +146,11 @@ class Staircase {
   double RemainingTime() const;
   // start + max_time_s, or time_point::max() for no limit.
   Clock::time_point Deadline() const;
-  // One level's local optimization (RTR or Ceres LBFGS) from Y; a level
-  // entered by an escape tests the certificate on the way
+  // One level's local optimization (RTR or Ceres LBFGS) from Y; with
+  // test_certificate (a level entered by an escape, whose certificate is
+  // tested after it) it tests the certificate on the way
   // (SolverOptions::test_certificate_after_escape).
-  void Optimize(int rank, bool after_escape, Eigen::MatrixXd* Y,
+  void Optimize(int rank, bool test_certificate, Eigen::MatrixXd* Y,
                 SolverSummary::Level* level);
   // The shift of a relative bound on the objective: relative_bound *
   // sdp_value / (d n), at least min_relative_eta's floor.
