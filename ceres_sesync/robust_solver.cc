@@ -224,6 +224,9 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
     return "mu_step must be a finite number > 1";
   }
   if (o.max_iterations < 0) return "max_iterations must be >= 0";
+  if (!(o.max_time_s >= 0) || !std::isfinite(o.max_time_s)) {
+    return "max_time_s must be a finite number >= 0";
+  }
   if (o.initial_max_rank < 0) return "initial_max_rank must be >= 0";
   if (o.gnc_max_rank < 0) return "gnc_max_rank must be >= 0";
   if (!(o.gnc_relative_gradient_tolerance >= 0) ||
@@ -342,6 +345,21 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // inlier problem is solved with the caller's options again. The
   // Staircase reads its options at every stage.
   SolverOptions solve_options = options.solver_options;
+  // Gives the next solve the time left (options.max_time_s) and says whether
+  // any is left. solve_options.max_time_s is the caller's per-solve limit
+  // or what remains of the whole, the smaller (the Staircase counts from the
+  // re-weighting or rebuild that precedes each solve).
+  auto budget = [&]() {
+    solve_options.max_time_s = options.solver_options.max_time_s;
+    if (options.max_time_s <= 0) return true;
+    const double left = options.max_time_s - Seconds(start);
+    if (left <= 0) return false;
+    if (solve_options.max_time_s <= 0 || left < solve_options.max_time_s) {
+      solve_options.max_time_s = left;
+    }
+    return true;
+  };
+  budget();
   const int r0 = options.solver_options.initial_rank > 0
                      ? options.solver_options.initial_rank
                      : d + 2;
@@ -383,7 +401,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   solve_options.max_rank = options.solver_options.max_rank;
   if (max_cost <= c2 &&
       problem.summary().status == SolverSummary::Status::kMaxRankReached &&
-      problem.summary().final_rank < solve_options.max_rank) {
+      problem.summary().final_rank < solve_options.max_rank && budget()) {
     // Every measurement fits: perhaps this is the inlier problem. The
     // staircase continues where a rank cap stopped it (as Solve() would).
     problem.staircase().Run(&Y0);
@@ -464,6 +482,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         options.solver_options.max_rank,
         options.gnc_max_rank > 0 ? std::max(options.gnc_max_rank, r0) : r0 + 2);
     for (int it = 0; it < options.max_iterations; ++it) {
+      if (!budget()) {
+        run.status = RobustSolverSummary::Status::kTimeLimit;
+        break;
+      }
       const auto step_start = Clock::now();
       MeasurementWeights next(m);
       for (size_t k = 0; k < m; ++k) {
@@ -515,6 +537,23 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     solve_options = options.solver_options;
     run.accepted.assign(m, 0);
     for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
+    auto record = [&]() {
+      f = Costs(graph, run.poses);
+      run.record.tls_cost = TlsCost(f, known, c2);
+      for (char a : run.accepted) run.record.num_outliers += !a;
+      run.record.certified = run.inlier_summary.certified();
+      run.record.time_s = Seconds(run_start);
+      return run;
+    };
+    if (run.status == RobustSolverSummary::Status::kTimeLimit || !budget()) {
+      // Out of time: the last step's poses (the first solve's if none ran)
+      // and its rounded weights; no inlier problem was solved.
+      run.status = RobustSolverSummary::Status::kTimeLimit;
+      run.message = "the time limit (max_time_s) ran out during GNC";
+      run.inlier_summary = problem.summary();
+      return record();
+    }
+    bool out_of_time = false;
     // Solves the problem restricted to `set` from *Y_io (updated in place).
     auto solve_set = [&](const std::vector<char>& set, Eigen::MatrixXd* Y_io,
                          Poses* poses) {
@@ -544,13 +583,19 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     auto make_consistent = [&]() {
       for (int round = 0; round < options.max_consistency_rounds; ++round) {
         f = Costs(graph, run.poses);
+        std::vector<char> next = run.accepted;
         bool changed = false;
         for (size_t k = 0; k < m; ++k) {
-          if (known[k] || run.accepted[k] == (f[k] <= c2)) continue;
-          run.accepted[k] = f[k] <= c2;
+          if (known[k] || next[k] == (f[k] <= c2)) continue;
+          next[k] = f[k] <= c2;
           changed = true;
         }
         if (!changed) return true;
+        if (!budget()) {
+          out_of_time = true;
+          return true;
+        }
+        run.accepted = std::move(next);
         ++run.record.consistency_rounds;
         if (!solve_accepted()) {
           message =
@@ -570,6 +615,16 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // factor: one more verification).
     std::vector<char> tried(m, 0);
     bool restore = false;
+    // The accepted set's report, for a restore the time limit prevents.
+    SolverSummary accepted_summary;
+    auto report_accepted = [&]() {
+      problem.staircase().Report(Y, Solution{run.poses, {}});
+      reported = true;
+      accepted_summary = problem.summary();
+    };
+    if (options.max_readmission_trials > 0 && !out_of_time) {
+      report_accepted();
+    }
     auto accepted_sum = [&](const std::vector<double>& costs,
                             const std::vector<char>& set) {
       double sum = 0;
@@ -601,6 +656,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         }
       }
       if (candidate < 0) break;
+      if (!budget()) {
+        out_of_time = true;
+        break;
+      }
       tried[candidate] = 1;
       ++run.record.readmission_trials;
       std::vector<char> set = run.accepted;
@@ -613,7 +672,9 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       }
       const std::vector<double> f_trial = Costs(graph, poses_trial);
       const double rise = accepted_sum(f_trial, set) - accepted_cost;
-      if (TlsCost(f_trial, known, c2) < TlsCost(f, known, c2) &&
+      // (A trial cut short by the time limit is not kept.)
+      if (problem.summary().status != SolverSummary::Status::kTimeLimit &&
+          TlsCost(f_trial, known, c2) < TlsCost(f, known, c2) &&
           rise < scale * c2) {
         run.accepted = std::move(set);
         Y = std::move(Y_trial);
@@ -621,21 +682,29 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         ++run.record.readmissions;
         restore = false;
         if (!make_consistent()) return disconnected("");
+        report_accepted();
       } else {
         restore = true;
       }
     }
-    if (restore && !solve_accepted()) {
-      return disconnected("the accepted measurements: ");
+    if (restore && !budget()) {
+      // No time to solve the accepted set again: its last report stands
+      // (run.poses and Y are still its optimum).
+      out_of_time = true;
+      run.inlier_summary = accepted_summary;
+    } else {
+      if (restore && !solve_accepted()) {
+        return disconnected("the accepted measurements: ");
+      }
+      if (!reported) problem.staircase().Report(Y, Solution{run.poses, {}});
+      run.inlier_summary = problem.summary();
     }
-    if (!reported) problem.staircase().Report(Y, Solution{run.poses, {}});
-    run.inlier_summary = problem.summary();
-    f = Costs(graph, run.poses);
-    run.record.tls_cost = TlsCost(f, known, c2);
-    for (char a : run.accepted) run.record.num_outliers += !a;
-    run.record.certified = run.inlier_summary.certified();
-    run.record.time_s = Seconds(run_start);
-    return run;
+    if (out_of_time) {
+      run.message =
+          "the time limit (max_time_s) stopped the consistency rounds or "
+          "re-admission trials after GNC";
+    }
+    return record();
   };
 
   // Every schedule; the lowest TLS cost at c^2 wins (the first on ties).
@@ -643,6 +712,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   GncRun best;
   int best_index = -1;
   for (size_t q = 0; q < options.gnc_threshold_fractions.size(); ++q) {
+    // Out of time: the runs so far (at least one) compete.
+    if (q > 0 && !budget()) break;
     GncRun run = run_gnc(options.gnc_threshold_fractions[q]);
     run.record.status = run.status;
     s.runs.push_back(run.record);
@@ -687,6 +758,8 @@ std::string RobustSolverSummary::StatusString() const {
       return "MAX_ITERATIONS";
     case Status::kInlierGraphDisconnected:
       return "INLIER_GRAPH_DISCONNECTED";
+    case Status::kTimeLimit:
+      return "TIME_LIMIT";
     case Status::kInvalidInput:
       return "INVALID_INPUT";
   }
@@ -696,7 +769,8 @@ std::string RobustSolverSummary::StatusString() const {
 std::string RobustSolverSummary::BriefReport() const {
   char buf[768];
   if (status == Status::kInvalidInput ||
-      status == Status::kInlierGraphDisconnected) {
+      status == Status::kInlierGraphDisconnected ||
+      status == Status::kTimeLimit) {
     std::snprintf(buf, sizeof(buf), "SE-Sync GNC-TLS: %s: %s",
                   StatusString().c_str(), message.c_str());
     return buf;
@@ -780,8 +854,15 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
     line("%-34s %s\n", "", message.c_str());
     return out;
   }
-  out += "\nProblem restricted to the accepted edges";
-  out += inlier_summary.FullReport();
+  if (status == Status::kTimeLimit) {
+    out +=
+        "\nProblem restricted to the accepted edges: not solved (the time "
+        "limit ran out during GNC; the verdicts are the last step's rounded "
+        "weights)\n";
+  } else {
+    out += "\nProblem restricted to the accepted edges";
+    out += inlier_summary.FullReport();
+  }
   out += "\nPer-edge verdicts";
   out += all_edges ? " (all)\n" : " (rejected)\n";
   line("  %8s %10s %10s %9s %12s %12s %12s %s\n", "edge", "vertex i",
@@ -801,11 +882,14 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   line("%-34s %.4f\n", "  Inlier problem", inlier_time_s);
   line("%-34s %.4f\n", "Total", total_time_s);
   line("\n%-34s %s\n", "Status", StatusString().c_str());
-  line(
-      "%-34s the optimum of the problem restricted to the accepted edges is "
-      "%s (%s); this is not a certificate for the TLS problem\n",
-      "", inlier_summary.certified() ? "certified" : "not certified",
-      inlier_summary.StatusString().c_str());
+  if (!message.empty()) line("%-34s %s\n", "", message.c_str());
+  if (status != Status::kTimeLimit) {
+    line(
+        "%-34s the optimum of the problem restricted to the accepted edges "
+        "is %s (%s); this is not a certificate for the TLS problem\n",
+        "", inlier_summary.certified() ? "certified" : "not certified",
+        inlier_summary.StatusString().c_str());
+  }
   return out;
 }
 

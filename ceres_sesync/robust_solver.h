@@ -80,8 +80,17 @@ namespace ceres_sesync {
 struct RobustSolverOptions {
   // Options of every weighted SE-Sync solve and of the final inlier
   // problem's (initialization, ranks, certification tolerances, threads).
-  // max_time_s limits each solve.
+  // Its max_time_s (0: none) limits each solve.
   SolverOptions solver_options;
+
+  // Wall-clock limit of the whole robust solve in seconds (0: none). Every
+  // solve gets the time left (or solver_options.max_time_s if smaller).
+  // When it runs out during GNC, GNC stops there (status kTimeLimit: the
+  // last step's poses and its weights rounded at 1/2; nothing certified);
+  // after GNC, the consistency rounds and re-admission trials stop and the
+  // last solved accepted set stands (certified if its solve was). Building
+  // a re-weighted problem's data matrices is not interrupted.
+  double max_time_s = 0;
 
   // TLS threshold c^2 on f_k (see the top of this file), in the units of
   // eq. (12). <= 0 (default): the inlier_probability quantile of chi^2 with
@@ -245,6 +254,9 @@ struct RobustSolverSummary {
     // of its parts is undetermined: no inlier problem was solved. The
     // returned poses are the last connected step's; see message.
     kInlierGraphDisconnected,
+    // max_time_s ran out before GNC ended (see max_time_s): the poses of
+    // the last step, verdicts from its weights; not certified.
+    kTimeLimit,
     // The graph or the options failed validation; see message.
     kInvalidInput,
   };
@@ -282,6 +294,9 @@ struct RobustSolverSummary {
   };
 
   Status status = Status::kInvalidInput;
+  // Why the input was invalid, the graph disconnected or the time ran out
+  // (also when the limit only stopped the consistency rounds or
+  // re-admission trials after GNC: status kConverged); else empty.
   std::string message;
   int dimension = 0, num_poses = 0, num_measurements = 0;
   // c^2 used (options.inlier_threshold or the chi-square quantile), and
@@ -328,7 +343,8 @@ struct RobustSolverSummary {
   // initial_max_rank; the complete Solve() when every measurement fits).
   SolverSummary initial_summary;
   // The final solve's: the problem restricted to the accepted measurements.
-  // Its objective, bounds and certificate are of that problem.
+  // Its objective, bounds and certificate are of that problem. (kTimeLimit:
+  // the last GNC step's weighted problem, or the first solve's.)
   SolverSummary inlier_summary;
   // Consistency rounds made after GNC (see max_consistency_rounds).
   int consistency_rounds = 0;
@@ -342,8 +358,8 @@ struct RobustSolverSummary {
          total_time_s = 0;
 
   // The optimum of the problem restricted to the accepted measurements is
-  // certified (inlier_summary.certified()). Never a statement about the TLS
-  // problem's global optimum.
+  // certified (inlier_summary.certified(); never for kTimeLimit). Never a
+  // statement about the TLS problem's global optimum.
   bool certified() const;
   std::string StatusString() const;
   std::string BriefReport() const;

@@ -99,6 +99,19 @@ TEST(RobustCommand, GeneratedOutliersAreTheRejectedEdges) {
   EXPECT_EQ(report.rfind("edge,vertex_i,vertex_j,weight,inlier,", 0), 0u);
   EXPECT_TRUE(FileExists(poses));
 
+  // --max_time limits the whole robust solve: out of time, TIME_LIMIT, not
+  // certified (exit 1), the verdicts of where it stopped.
+  const std::string limited_json = TempPath("limited.json");
+  EXPECT_EQ(RunTool("solve " + corrupted + " --robust --max_time 0.0001 " +
+                    "--json " + limited_json),
+            1);
+  const std::string limited = ReadFile(limited_json);
+  EXPECT_NE(limited.find("\"robust_status\": \"TIME_LIMIT\""),
+            std::string::npos)
+      << limited;
+  EXPECT_NE(limited.find("\"certified\": false"), std::string::npos);
+  std::remove(limited_json.c_str());
+
   // The default indices path, and the plain solve is not robust.
   const std::string corrupted2 = TempPath("corrupted2.g2o");
   ASSERT_EQ(RunTool("generate outliers " + clean +

@@ -5,6 +5,7 @@
 
 #include "ceres_sesync/robust_solver.h"
 
+#include <chrono>
 #include <cmath>
 #include <random>
 #include <string>
@@ -256,6 +257,51 @@ TEST(RobustSolver, GncStepsStopAtGncMaxRankWithoutTheTopCertificateTest) {
       EXPECT_LE(step.rank, r0 + 2);
     }
     EXPECT_EQ(s.outlier_edges, added) << s.FullReport();
+  }
+}
+
+// max_time_s limits the whole robust solve. Out of time during GNC: status
+// kTimeLimit, not certified, the poses and verdicts of where it stopped;
+// with time to spare: the result of the unlimited solve.
+TEST(RobustSolver, TimeLimitHoldsForTheWholeSolve) {
+  for (int d : {2, 3}) {
+    PoseGraph corrupted;
+    std::vector<int> added;
+    ASSERT_TRUE(NoisyChainWithOutliers(d, &corrupted, &added));
+    RobustSolverSummary unlimited;
+    const Poses full = SolveRobust(corrupted, Options(), &unlimited);
+    ASSERT_TRUE(unlimited.certified()) << unlimited.FullReport();
+
+    RobustSolverOptions options = Options();
+    options.max_time_s = 1e-4;
+    RobustSolverSummary s;
+    const auto start = std::chrono::steady_clock::now();
+    const Poses poses = SolveRobust(corrupted, options, &s);
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count();
+    EXPECT_EQ(s.status, RobustSolverSummary::Status::kTimeLimit)
+        << s.FullReport();
+    EXPECT_FALSE(s.certified());
+    // Far below the unlimited solve's time, or any solve's per-solve limit
+    // (none here): each solve got only what was left.
+    EXPECT_LT(elapsed, 0.5 * unlimited.total_time_s + 0.05);
+    EXPECT_EQ(static_cast<int>(poses.size()), corrupted.num_poses);
+    ASSERT_EQ(s.edges.size(), corrupted.measurements.size());
+    EXPECT_EQ(s.num_inliers + s.num_outliers,
+              static_cast<int>(corrupted.measurements.size()));
+    EXPECT_THAT(s.FullReport(), testing::HasSubstr("TIME_LIMIT"));
+
+    options.max_time_s = 1000;
+    SolveRobust(corrupted, options, &s);
+    EXPECT_EQ(s.status, unlimited.status);
+    EXPECT_TRUE(s.certified());
+    EXPECT_EQ(s.outlier_edges, unlimited.outlier_edges);
+    EXPECT_TRUE(s.message.empty()) << s.message;
+
+    options.max_time_s = -1;
+    SolveRobust(corrupted, options, &s);
+    EXPECT_EQ(s.status, RobustSolverSummary::Status::kInvalidInput);
   }
 }
 

@@ -256,6 +256,8 @@ int RunSolve(const Args& args) {
     AddComponents(graph, summary, &json);
   } else if (FLAGS_robust) {
     robust_options.solver_options = options;
+    // --max_time limits the whole command, not each of its solves.
+    robust_options.max_time_s = options.max_time_s;
     solution.poses = SolveRobust(graph, robust_options, &robust);
     if (progress) progress->Finish();
     std::cout << robust.FullReport() << std::flush;
@@ -270,11 +272,15 @@ int RunSolve(const Args& args) {
       std::fprintf(stderr, "ceres_sesync solve: %s: %s\n", path.c_str(),
                    robust.message.c_str());
     }
+    // Out of time during GNC: no inlier problem was solved (exit 1).
+    const bool timed_out =
+        robust.status == RobustSolverSummary::Status::kTimeLimit;
     // The problem of the accepted edges.
     const SolverSummary& summary = robust.inlier_summary;
-    certified = summary.certified();
-    AddSummary(summary, &json,
-               disconnected ? robust.StatusString() : std::string());
+    certified = robust.certified();
+    AddSummary(
+        summary, &json,
+        disconnected || timed_out ? robust.StatusString() : std::string());
     AddRobustJson(robust, &json);
   } else {
     SolverSummary summary;

@@ -987,6 +987,7 @@ void BindRobust(py::module_& m) {
           &O::gnc_relative_gradient_tolerance)
       .rw("mu_step", &O::mu_step)
       .rw("max_iterations", &O::max_iterations)
+      .rw("max_time_s", &O::max_time_s)
       .rw("weight_tolerance", &O::weight_tolerance)
       .rw("relative_cost_tolerance", &O::relative_cost_tolerance)
       .rw("max_consistency_rounds", &O::max_consistency_rounds)
