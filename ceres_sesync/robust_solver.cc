@@ -622,7 +622,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       reported = true;
       accepted_summary = problem.summary();
     };
-    if (options.max_readmission_trials > 0 && !out_of_time) {
+    // (Only under a time limit: the report may tighten the proof in
+    // double-double, which the final report does otherwise.)
+    const bool snapshots = options.max_time_s > 0;
+    if (snapshots && options.max_readmission_trials > 0 && !out_of_time) {
       report_accepted();
     }
     auto accepted_sum = [&](const std::vector<double>& costs,
@@ -682,7 +685,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         ++run.record.readmissions;
         restore = false;
         if (!make_consistent()) return disconnected("");
-        report_accepted();
+        if (snapshots) report_accepted();
       } else {
         restore = true;
       }
