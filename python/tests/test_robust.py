@@ -97,6 +97,21 @@ def test_options_and_errors():
     assert o.inlier_probability == 0.99 and o.as_dict()["known_inliers"] is not None
 
 
+def test_time_limit_is_of_the_whole_solve_and_rank_cap():
+    rng = np.random.default_rng(7)
+    g, _, _, wrong = corrupted_graph(rng, 3, 40, 20, 12)
+    # max_time_s is RobustSolverOptions' (the whole solve), not each solve's.
+    r = cs.solve(g, robust=True, max_time_s=1e-4)
+    assert r.status == "TIME_LIMIT" and not r.certified, r.summary
+    assert r.inliers.shape == (g.num_measurements,)
+    r = cs.solve(g, robust=True, max_time_s=1000.0, gnc_max_rank=5)
+    assert r.status == "CONVERGED" and r.certified, r.summary
+    np.testing.assert_array_equal(r.outlier_edges, wrong)
+    assert cs.RobustSolverOptions(gnc_max_rank=5).gnc_max_rank == 5
+    with pytest.raises(ValueError, match="max_time_s"):
+        cs.solve(g, robust=True, max_time_s=-1.0)
+
+
 def test_outlier_edges_equal_the_command_line(tmp_path):
     rng = np.random.default_rng(7)
     g, R, t, wrong = corrupted_graph(rng, 3, 30, 15, 6)
