@@ -353,7 +353,9 @@ struct RobustSolverSummary {
   // Times the weighted problem was rebuilt on the subgraph of positive
   // weights (to shed the fill of rejected measurements).
   int pattern_rebuilds = 0;
-  // Seconds: the first solve, the GNC steps, the final inlier solve, total.
+  // Seconds: the first solve; every GNC run (each with its inlier problem);
+  // of the selected run, what followed its GNC steps (the inlier problem,
+  // consistency rounds and re-admission trials); total.
   double initial_time_s = 0, gnc_time_s = 0, inlier_time_s = 0,
          total_time_s = 0;
 

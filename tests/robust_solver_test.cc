@@ -178,6 +178,14 @@ TEST(RobustSolver, WeightsConvergeToZeroOrOne) {
     for (const RobustSolverSummary::Run& r : s.runs) {
       EXPECT_GE(r.tls_cost, s.runs[s.selected_run].tls_cost);
     }
+    // The selected run's time after its GNC steps (the inlier problem was
+    // solved: > 0) is part of that run's, which is part of all runs'.
+    EXPECT_GT(s.inlier_time_s, 0);
+    EXPECT_LE(s.inlier_time_s, s.runs[s.selected_run].time_s);
+    EXPECT_LE(s.gnc_time_s, s.total_time_s);
+    double runs = 0;
+    for (const RobustSolverSummary::Run& r : s.runs) runs += r.time_s;
+    EXPECT_LE(runs, s.gnc_time_s);
   }
 }
 
