@@ -552,10 +552,27 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     };
     if (run.status == RobustSolverSummary::Status::kTimeLimit || !budget()) {
       // Out of time: the last step's poses (the first solve's if none ran)
-      // and its rounded weights; no inlier problem was solved.
+      // and its rounded weights; no inlier problem was solved, so its
+      // summary proves nothing (the last step's is of a weighted problem).
       run.status = RobustSolverSummary::Status::kTimeLimit;
-      run.message = "the time limit (max_time_s) ran out during GNC";
-      run.inlier_summary = problem.summary();
+      run.message =
+          "the time limit (max_time_s) ran out before the inlier problem "
+          "was solved";
+      SolverSummary& cut = run.inlier_summary;
+      cut = SolverSummary();
+      cut.status = SolverSummary::Status::kTimeLimit;
+      cut.message = run.message;
+      cut.dimension = d;
+      cut.num_poses = graph.num_poses;
+      const std::vector<double> costs = Costs(graph, run.poses);
+      for (size_t k = 0; k < m; ++k) {
+        if (!run.accepted[k]) continue;
+        ++cut.num_measurements;
+        cut.objective += costs[k];
+      }
+      cut.suboptimality_bound = cut.relative_suboptimality_bound = cut.eta =
+          std::numeric_limits<double>::infinity();
+      cut.proof_precision = "none";
       return record();
     }
     bool out_of_time = false;

@@ -299,6 +299,11 @@ TEST(RobustSolver, TimeLimitHoldsForTheWholeSolve) {
     EXPECT_EQ(s.num_inliers + s.num_outliers,
               static_cast<int>(corrupted.measurements.size()));
     EXPECT_THAT(s.FullReport(), testing::HasSubstr("TIME_LIMIT"));
+    // No inlier problem was solved: its summary proves nothing.
+    EXPECT_EQ(s.inlier_summary.status, SolverSummary::Status::kTimeLimit);
+    EXPECT_FALSE(s.inlier_summary.certified());
+    EXPECT_TRUE(std::isinf(s.inlier_summary.relative_suboptimality_bound));
+    EXPECT_EQ(s.inlier_summary.num_measurements, s.num_inliers);
 
     options.max_time_s = 1000;
     SolveRobust(corrupted, options, &s);
