@@ -742,14 +742,23 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     GncRun run = run_gnc(options.gnc_threshold_fractions[q]);
     run.record.status = run.status;
     s.runs.push_back(run.record);
-    const bool usable =
-        run.status != RobustSolverSummary::Status::kInlierGraphDisconnected;
-    const bool best_usable =
-        best_index >= 0 &&
-        best.status != RobustSolverSummary::Status::kInlierGraphDisconnected;
-    if (best_index < 0 ||
-        (usable &&
-         (!best_usable || run.record.tls_cost < best.record.tls_cost))) {
+    // A finished run beats one the time limit cut short (its verdicts are
+    // rounded weights, its inlier problem unsolved), which beats a
+    // disconnected one; then the lower TLS cost wins.
+    auto tier = [](RobustSolverSummary::Status status) {
+      switch (status) {
+        case RobustSolverSummary::Status::kInlierGraphDisconnected:
+          return 0;
+        case RobustSolverSummary::Status::kTimeLimit:
+          return 1;
+        default:
+          return 2;
+      }
+    };
+    const int run_tier = tier(run.status);
+    const int best_tier = best_index < 0 ? -1 : tier(best.status);
+    if (run_tier > best_tier || (run_tier == best_tier && run_tier > 0 &&
+                                 run.record.tls_cost < best.record.tls_cost)) {
       best = std::move(run);
       best_index = static_cast<int>(q);
     }

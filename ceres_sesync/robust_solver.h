@@ -88,8 +88,9 @@ struct RobustSolverOptions {
   // When it runs out during GNC, GNC stops there (status kTimeLimit: the
   // last step's poses and its weights rounded at 1/2; nothing certified);
   // after GNC, the consistency rounds and re-admission trials stop and the
-  // last solved accepted set stands (certified if its solve was). Building
-  // a re-weighted problem's data matrices is not interrupted.
+  // last solved accepted set stands (certified if its solve was). A GNC run
+  // cut short is selected only if no run finished. Building a re-weighted
+  // problem's data matrices is not interrupted.
   double max_time_s = 0;
 
   // TLS threshold c^2 on f_k (see the top of this file), in the units of
