@@ -571,28 +571,20 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
     sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
     level.sdp_value = sdp_value_;
-    if (!tested) {
+
+    if (tested) {
+      Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
+      t = Clock::now();
+      verification_ = Verify(*Y, sdp_value_);
+      level.verify_time_s +=
+          std::chrono::duration<double>(Clock::now() - t).count();
+    } else {
+      // No test: nothing proven, no factorization.
       verification_ = VerificationResult();
       verification_.eta = std::numeric_limits<double>::infinity();
       verification_.lambda_min_estimate =
           std::numeric_limits<double>::quiet_NaN();
-      level.eta = verification_.eta;
-      level.lambda_min_estimate = verification_.lambda_min_estimate;
-      lower_bound_ = 0;
-      s.iterations += level.iterations;
-      s.hessian_vector_products += level.hessian_vector_products;
-      s.optimization_time_s += level.optimize_time_s;
-      s.levels.push_back(level);
-      s.final_rank = r;
-      s.status = SolverSummary::Status::kMaxRankReached;
-      return;
     }
-
-    Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
-    t = Clock::now();
-    verification_ = Verify(*Y, sdp_value_);
-    level.verify_time_s +=
-        std::chrono::duration<double>(Clock::now() - t).count();
     level.certified = verification_.certified;
     level.eta = verification_.eta;
     level.lambda_min_estimate = verification_.lambda_min_estimate;
@@ -619,6 +611,10 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
                 << verification_.eta << ", lambda_min estimate "
                 << verification_.lambda_min_estimate
                 << (verification_.certified ? " (certified)" : "");
+    }
+    if (!tested) {  // At max_rank: nothing to escape to.
+      s.status = SolverSummary::Status::kMaxRankReached;
+      return;
     }
     if (verification_.certified) {
       s.status = SolverSummary::Status::kCertifiedOptimum;
