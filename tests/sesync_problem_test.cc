@@ -758,5 +758,72 @@ TEST(SESyncPreconditioner, AllTypesAreDocumentedOperatorsAndSpdOnTangent) {
   }
 }
 
+// kAdaptive: block-Jacobi until a rule of PreconditionerSettings fires, then
+// the exact (Q + eps I)^{-1}, with the documented operators before and after.
+TEST(SESyncPreconditioner, AdaptiveSwitchesByItsRules) {
+  std::mt19937_64 rng(37);
+  RandomGraphOptions o;
+  o.dimension = 2;
+  o.num_poses = 25;
+  o.num_loop_closures = 30;
+  o.seed = 41;
+  const PoseGraph graph = RandomPoseGraph(o, nullptr);
+  SESyncProblem problem(graph);
+  ASSERT_TRUE(problem.ok());
+  const int d = 2, n = problem.num_rotations(), dn = d * n;
+  const double max_condition = 1e6;
+  const MatrixXd D = MatrixXd(problem.D());
+  const double eps = D.cwiseAbs().rowwise().sum().maxCoeff() / max_condition;
+  MatrixXd block_jacobi = MatrixXd::Zero(dn, dn);
+  for (int i = 0; i < n; ++i) {
+    block_jacobi.block(d * i, d * i, d, d) =
+        (D.block(d * i, d * i, d, d) + eps * MatrixXd::Identity(d, d))
+            .inverse();
+  }
+  const MatrixXd exact =
+      (ReferenceQ(graph) + eps * MatrixXd::Identity(dn, dn)).inverse();
+  const MatrixXd V = Gaussian(4, dn, &rng);
+  auto applies = [&](const SESyncPreconditioner& p, const MatrixXd& inverse) {
+    MatrixXd X;
+    p.Apply(V, &X);
+    return RelativeError(X, V * inverse) < 1e-8;
+  };
+
+  // The rule of kAutomatic's block-Jacobi: only the total counts.
+  internal::PreconditionerSettings total;
+  total.switch_iterations = 0;
+  total.switch_at_convergence = false;
+  total.switch_total_iterations = 10;
+  SESyncPreconditioner p(problem, PreconditionerType::kAdaptive, max_condition,
+                         nullptr, total);
+  EXPECT_TRUE(applies(p, block_jacobi));
+  EXPECT_FALSE(p.Update(4, false));
+  EXPECT_FALSE(p.Update(0, true));   // Convergence does not switch.
+  EXPECT_FALSE(p.Update(6, false));  // 10 in all: not more than 10.
+  EXPECT_FALSE(p.exact());
+  EXPECT_TRUE(applies(p, block_jacobi));
+  EXPECT_TRUE(p.Update(1, false));
+  EXPECT_TRUE(p.exact());
+  EXPECT_EQ(p.switches(), 1);
+  EXPECT_EQ(p.block_jacobi_iterations(), 11);
+  EXPECT_TRUE(applies(p, exact));
+  EXPECT_FALSE(p.Update(100, false));  // Switches once.
+  EXPECT_EQ(p.block_jacobi_iterations(), 11);
+  p.Refresh();  // Re-weighting keeps the mode.
+  EXPECT_TRUE(applies(p, exact));
+
+  // The default rules: one long solve, or convergence.
+  SESyncPreconditioner long_solve(problem, PreconditionerType::kAdaptive,
+                                  max_condition);
+  EXPECT_FALSE(long_solve.Update(20, false));
+  EXPECT_FALSE(long_solve.Update(20, false));  // No total limit by default.
+  EXPECT_TRUE(long_solve.Update(21, false));
+  EXPECT_TRUE(applies(long_solve, exact));
+  SESyncPreconditioner converged(problem, PreconditionerType::kAdaptive,
+                                 max_condition);
+  EXPECT_TRUE(converged.Update(0, true));
+  EXPECT_TRUE(applies(converged, exact));
+}
+
 }  // namespace
 }  // namespace ceres_sesync

@@ -97,7 +97,14 @@ void SESyncPreconditioner::FactorizeRegularizedQ() {
 
 bool SESyncPreconditioner::Update(int inner_iterations, bool converged) {
   if (type_ != PreconditionerType::kAdaptive || exact_) return false;
-  if (!converged && inner_iterations <= settings_.switch_iterations) {
+  block_jacobi_iterations_ += inner_iterations;
+  const bool long_solve = settings_.switch_iterations > 0 &&
+                          inner_iterations > settings_.switch_iterations;
+  const bool long_total =
+      settings_.switch_total_iterations > 0 &&
+      block_jacobi_iterations_ > settings_.switch_total_iterations;
+  if (!(converged && settings_.switch_at_convergence) && !long_solve &&
+      !long_total) {
     return false;
   }
   FactorizeRegularizedQ();

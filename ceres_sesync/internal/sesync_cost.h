@@ -34,11 +34,16 @@ enum class FactorPrecision { kDouble, kSingle };
 struct PreconditionerSettings {
   FactorPrecision precision = FactorPrecision::kDouble;
   // kAdaptive switches to the exact preconditioner once a truncated-CG solve
-  // under block-Jacobi needs more than this many iterations. (It also
-  // switches when the stopping test is met under block-Jacobi, so that the
-  // test that ends a solve is always the exact preconditioner's, as with
-  // kRegularizedQ.)
+  // under block-Jacobi needs more than this many iterations (0: never for
+  // this reason), ...
   int switch_iterations = 20;
+  // ... once the truncated-CG solves under block-Jacobi have taken more
+  // than this many iterations in all (0: no such limit), ...
+  int switch_total_iterations = 0;
+  // ... and, if this is set, when the stopping test is met under
+  // block-Jacobi, so that the test that ends a solve is always the exact
+  // preconditioner's, as with kRegularizedQ.
+  bool switch_at_convergence = true;
 };
 
 // Approximate inverse of the Euclidean Hessian 2Q: either from
@@ -71,13 +76,15 @@ class SESyncPreconditioner {
   // For kAdaptive (a no-op returning false otherwise): after a truncated-CG
   // solve that took `inner_iterations` (converged = false), or when the
   // stopping test was met (converged = true). Switches from block-Jacobi to
-  // the exact (Q + eps I)^{-1} when that solve needed more than
-  // settings.switch_iterations or on convergence, and returns true iff it
-  // switched (Apply() is then the exact operator from now on).
+  // the exact (Q + eps I)^{-1} by the rules of PreconditionerSettings and
+  // returns true iff it switched (Apply() is then the exact operator from
+  // now on).
   bool Update(int inner_iterations, bool converged);
-  // Whether Apply() is (Q + eps I)^{-1} now, and how often it switched.
+  // Whether Apply() is (Q + eps I)^{-1} now, how often it switched, and the
+  // truncated-CG iterations taken under block-Jacobi before that.
   bool exact() const { return exact_; }
   int switches() const { return switches_; }
+  int block_jacobi_iterations() const { return block_jacobi_iterations_; }
   // The exact preconditioner's factor (empty before it is computed).
   const SparseCholeskyFactor& factor() const { return factor_; }
 
@@ -99,6 +106,7 @@ class SESyncPreconditioner {
   std::unique_ptr<CholmodFactor> d_factor_;
   bool exact_ = false;
   int switches_ = 0;
+  int block_jacobi_iterations_ = 0;
   Eigen::MatrixXd block_inverses_;  // d x dn, for block-Jacobi.
   // D + eps I (kSparseCholesky) or K_eps (kRegularizedQ, whose first
   // translation_size_ unknowns are the translations).
