@@ -145,6 +145,7 @@ std::string SolverSummary::FullReport() const {
   line("%-34s %d\n", "Final rank", final_rank);
   line("%-34s %d\n", "Trust-region iterations", iterations);
   line("%-34s %d\n", "Hessian-vector products", hessian_vector_products);
+  line("%-34s %s\n", "Preconditioner", preconditioner.c_str());
   line("%-34s %d double, %d double-double (%.4f s)\n",
        "Certificate factorizations", factorizations, extended_factorizations,
        extended_proof_time_s);

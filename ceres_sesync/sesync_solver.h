@@ -67,6 +67,23 @@ struct SolverOptions {
     // translation-augmented matrix [Lbar -Vbar; -Vbar^T D + eps I] (its Schur
     // complement is Q + eps I). Best on strongly translation-coupled graphs.
     kRegularizedQ,
+    // kRegularizedQ, except where its factor is predicted to be costly:
+    // where factorizing K_eps costs more than 3 applications of its factor
+    // (CHOLMOD's symbolic prediction of flops and entries at the initial
+    // rank; deterministic), block-Jacobi, which switches to kRegularizedQ
+    // for the rest of the solve once its truncated-CG iterations exceed 20
+    // times that ratio in all. Such factors are those of well-connected
+    // maps (2D cities 4-25, sphere2500 and cubicle 7.6, torus3D 11), where
+    // block-Jacobi needs 1.6-3x the Hessian-vector products (cubicle 4x,
+    // torus3D 11x) but each costs 3-5x less and nothing is factorized; on
+    // long trajectories (kitti_00, ais2klinik, CSAIL, intel, manhattan,
+    // parking-garage: ratios 0.5-2.2) it would need 10-180x the products.
+    // Measured (one thread, same results; bench/results/preconditioner_auto):
+    // city10000 0.65 -> 0.39 s, sphere2500 0.36 -> 0.19 s, 1000 to 10^5-pose
+    // cities 1.13-1.37x faster; cubicle 8% and torus3D 2% slower; with two
+    // threads a 10^5-pose city only 4% faster. SolverSummary::preconditioner
+    // says which one ran. Recommended.
+    kAutomatic,
   };
 
   // How the staircase is started. Solve(graph, initial, ...) overrides this.
@@ -80,7 +97,7 @@ struct SolverOptions {
 
   // Preconditioner of the truncated CG inner solver, and the condition number
   // cap of the regularized ones: eps = lambda_max(D) / cap.
-  Preconditioner preconditioner = Preconditioner::kRegularizedQ;
+  Preconditioner preconditioner = Preconditioner::kAutomatic;
   double regularized_cholesky_max_condition = 1e6;
 
   enum class LocalSolver {
@@ -271,6 +288,11 @@ struct SolverSummary {
   int final_rank = 0;
   int iterations = 0;
   int hessian_vector_products = 0;
+  // The truncated-CG preconditioner the solve ended with (kAutomatic
+  // resolved): "none", "block-Jacobi", "sparse Cholesky of D" or "exact
+  // (Q + eps I)^-1"; when kAutomatic's block-Jacobi switched, "exact (Q +
+  // eps I)^-1 after N block-Jacobi iterations".
+  std::string preconditioner;
   // Cholesky factorizations of the certificate matrix in verification
   // (certificate tests included), in double and in double-double, and the
   // seconds the latter took (part of verification_time_s).

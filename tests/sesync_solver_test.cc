@@ -188,6 +188,52 @@ TEST(SESyncSolver, InitializationsAndPreconditionersAgree) {
   EXPECT_FALSE(s.message.empty());
 }
 
+// kAutomatic resolves by the predicted cost of the exact preconditioner's
+// factorization in applications of its factor: block-Jacobi on a city (2D,
+// 1000 poses: 4.1 > 3), the exact preconditioner on a 3D cube (0.5); either
+// way the optimum certified with the exact preconditioner, to the stopping
+// test's precision.
+TEST(SESyncSolver, AutomaticPreconditionerFollowsTheFactorCost) {
+  CityOptions city;
+  city.num_poses = 1000;
+  city.seed = 1;
+  PoseGraph city_graph;
+  std::string error;
+  ASSERT_TRUE(GenerateCity(city, &city_graph, nullptr, &error)) << error;
+  const PoseGraph cube = Cube(3, 5, 16.67, 75, 3);
+  struct Case {
+    const PoseGraph* graph;
+    const char* expected;
+  };
+  for (const Case& c : {Case{&city_graph, "block-Jacobi"},
+                        Case{&cube, "exact (Q + eps I)^-1"}}) {
+    SolverOptions automatic;
+    automatic.num_threads = 1;
+    SolverOptions exact = automatic;
+    exact.preconditioner = SolverOptions::Preconditioner::kRegularizedQ;
+    EXPECT_EQ(SolverOptions().preconditioner,
+              SolverOptions::Preconditioner::kAutomatic);
+    SolverSummary s_auto, s_exact;
+    const Poses x_auto = Solve(*c.graph, automatic, &s_auto);
+    const Poses x_exact = Solve(*c.graph, exact, &s_exact);
+    SCOPED_TRACE(c.expected);
+    EXPECT_EQ(s_auto.preconditioner, c.expected);
+    EXPECT_EQ(s_exact.preconditioner, "exact (Q + eps I)^-1");
+    EXPECT_EQ(s_auto.status, Status::kCertifiedOptimum) << s_auto.FullReport();
+    EXPECT_EQ(s_exact.status, Status::kCertifiedOptimum);
+    EXPECT_LE(s_auto.relative_suboptimality_bound, 1e-6);
+    // Both within the stopping test's relative precision of the optimum.
+    EXPECT_NEAR(s_auto.objective, s_exact.objective, 1e-9 * s_exact.objective);
+    EXPECT_NEAR(EvaluateObjective(*c.graph, x_auto),
+                EvaluateObjective(*c.graph, x_exact), 1e-9 * s_exact.objective);
+    // A proven lower bound holds for every solution.
+    EXPECT_LE(s_auto.lower_bound, s_exact.objective);
+    EXPECT_LE(s_exact.lower_bound, s_auto.objective);
+    // The dense certificate check where it is small (dn = 375).
+    if (c.graph == &cube) ExpectCertifiedOptimum(cube, x_auto, s_auto);
+  }
+}
+
 // num_threads only splits independent work: a graph large enough for the
 // parallel solves and the parallel double-double factorization (and whose
 // preconditioner is built during the initialization) gives bitwise
@@ -470,6 +516,31 @@ TEST(SESyncSolver, SmallDatasetsMatchPublishedOptima) {
     std::printf("%s: F = %.6e, rel. bound %.2e, %.3f s\n", c.file, s.objective,
                 s.relative_suboptimality_bound, s.total_time_s);
   }
+}
+
+// cubicle's exact factor is costly (7.6 applications of it), so kAutomatic
+// starts with block-Jacobi, whose truncated CG there needs more than its
+// budget (20 x 7.6): it switches to the exact preconditioner and certifies
+// the published optimum.
+TEST(SESyncSolver, AutomaticPreconditionerSwitchesWhenBlockJacobiIsSlow) {
+  const std::string path = std::string(CERES_SESYNC_DATA_DIR) + "/cubicle.g2o";
+  if (FILE* f = std::fopen(path.c_str(), "r")) {
+    std::fclose(f);
+  } else {
+    GTEST_SKIP() << "dataset absent: " << path;
+  }
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(ReadG2oFile(path, G2oReadOptions(), &graph, &error)) << error;
+  SolverOptions o;
+  o.num_threads = 1;
+  SolverSummary s;
+  Solve(graph, o, &s);
+  EXPECT_EQ(s.status, Status::kCertifiedOptimum) << s.FullReport();
+  EXPECT_NEAR(s.objective, 7.171e2, 0.05);  // Rosen et al. 2019, Table 2.
+  const std::string prefix = "exact (Q + eps I)^-1 after ";
+  ASSERT_EQ(s.preconditioner.rfind(prefix, 0), 0u) << s.preconditioner;
+  EXPECT_GT(std::stoi(s.preconditioner.substr(prefix.size())), 20 * 7);
 }
 
 // A 1000-pose city at kappa 10 (seed 1) has a rank-4 saddle: the staircase

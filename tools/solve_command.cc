@@ -20,8 +20,9 @@ DEFINE_string(init, "chordal",
 DECLARE_uint64(seed);  // Defined in generate_command.cc.
 DEFINE_int32(initial_rank, 0, "Initial staircase rank (0: d + 2).");
 DEFINE_int32(max_rank, 10, "Maximum staircase rank.");
-DEFINE_string(preconditioner, "q",
-              "Truncated-CG preconditioner: q (regularized Q, exact "
+DEFINE_string(preconditioner, "auto",
+              "Truncated-CG preconditioner: auto (block-Jacobi where the "
+              "exact one's factor is costly, else q)|q (regularized Q, exact "
               "Schur complement)|cholesky (of Q's sparse part)|jacobi|none.");
 DEFINE_string(local_solver, "rtr",
               "Staircase local solver: rtr (built-in trust region) | "
@@ -94,6 +95,7 @@ void AddSummary(const SolverSummary& summary, internal::JsonWriter* json,
   json->String("status", status.empty() ? summary.StatusString() : status);
   json->Int("iterations", summary.iterations);
   json->Int("hessian_vector_products", summary.hessian_vector_products);
+  json->String("preconditioner", summary.preconditioner);
   json->BeginObject("proof");
   json->String("precision", summary.proof_precision);
   json->Int("factorizations", summary.factorizations);
@@ -164,7 +166,9 @@ int RunSolve(const Args& args) {
   } else {
     return InputError("unknown --init '" + FLAGS_init + "'");
   }
-  if (FLAGS_preconditioner == "q") {
+  if (FLAGS_preconditioner == "auto") {
+    options.preconditioner = SolverOptions::Preconditioner::kAutomatic;
+  } else if (FLAGS_preconditioner == "q") {
     options.preconditioner = SolverOptions::Preconditioner::kRegularizedQ;
   } else if (FLAGS_preconditioner == "cholesky") {
     options.preconditioner = SolverOptions::Preconditioner::kSparseCholesky;

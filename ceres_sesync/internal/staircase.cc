@@ -29,8 +29,70 @@ PreconditionerType ToInternal(SolverOptions::Preconditioner p) {
       return PreconditionerType::kSparseCholesky;
     case SolverOptions::Preconditioner::kRegularizedQ:
       return PreconditionerType::kRegularizedQ;
+    case SolverOptions::Preconditioner::kAutomatic:
+      return PreconditionerType::kAdaptive;
   }
   return PreconditionerType::kNone;
+}
+
+// SolverOptions::Preconditioner::kAutomatic: block-Jacobi (kAdaptive, with
+// the switch rule below) where K_eps's factorization costs more than this
+// many applications of its factor at the initial rank, else kRegularizedQ.
+// Measured ratios: 2D cities 4.1 (1000 poses) to 24.7 (10^5 poses),
+// city10000 5.3, cubicle and sphere2500 7.6, torus3D 11.0, smallGrid3D 3.2
+// (block-Jacobi faster on all but cubicle and torus3D: 8% and 2% slower
+// there); kitti_00 and the generated 3D cubes 0.5-0.8, ais2klinik and CSAIL
+// 0.6, intel 1.0, parking-garage 1.7, manhattan 2.2 (block-Jacobi 2.8-25x
+// slower).
+constexpr double kDenseFactorSolves = 3;
+// ... and block-Jacobi switches to the exact preconditioner once its
+// truncated-CG iterations exceed this multiple of that ratio in all (a
+// bound on what a wrong choice costs: roughly 10 factorizations' worth of
+// products). Block-Jacobi's own totals on the sets above: 4.9 (10^5-pose
+// city) to 19 (city10000) times the ratio; cubicle's 38.
+constexpr double kBlockJacobiBudget = 20;
+
+struct PreconditionerChoice {
+  PreconditionerType type;
+  PreconditionerSettings settings;
+};
+
+PreconditionerChoice ChoosePreconditioner(const SolverOptions& options,
+                                          const CertificateMatrix& K, int r0) {
+  PreconditionerChoice choice{ToInternal(options.preconditioner), {}};
+  if (options.preconditioner != SolverOptions::Preconditioner::kAutomatic) {
+    return choice;
+  }
+  const double ratio = K.FactorizationCostInSolves(r0);
+  if (!(ratio > kDenseFactorSolves)) {
+    choice.type = PreconditionerType::kRegularizedQ;
+    return choice;
+  }
+  choice.settings.switch_iterations = 0;
+  choice.settings.switch_at_convergence = false;
+  choice.settings.switch_total_iterations =
+      static_cast<int>(std::ceil(kBlockJacobiBudget * ratio));
+  return choice;
+}
+
+// SolverSummary::preconditioner.
+std::string PreconditionerName(const SESyncPreconditioner& p) {
+  switch (p.type()) {
+    case PreconditionerType::kNone:
+      return "none";
+    case PreconditionerType::kBlockJacobi:
+      return "block-Jacobi";
+    case PreconditionerType::kSparseCholesky:
+      return "sparse Cholesky of D";
+    case PreconditionerType::kRegularizedQ:
+      return "exact (Q + eps I)^-1";
+    case PreconditionerType::kAdaptive:
+      return p.exact() ? "exact (Q + eps I)^-1 after " +
+                             std::to_string(p.block_jacobi_iterations()) +
+                             " block-Jacobi iterations"
+                       : "block-Jacobi";
+  }
+  return "";
 }
 
 double MaxDiagonal(const SparseMatrix& A) {
@@ -144,10 +206,16 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     return;
   }
   certificate_ = std::make_unique<CertificateMatrix>(*problem_);
-  auto build = [this] {
+  const PreconditionerChoice choice =
+      ChoosePreconditioner(options, *certificate_, r0_);
+  auto build = [this, choice] {
+    // kAdaptive factorizes in a workspace of its own when it switches
+    // (certificate_ may then hold a certificate test's factor).
     preconditioner_ = std::make_unique<SESyncPreconditioner>(
-        *problem_, ToInternal(options_.preconditioner),
-        options_.regularized_cholesky_max_condition, certificate_.get());
+        *problem_, choice.type, options_.regularized_cholesky_max_condition,
+        choice.type == PreconditionerType::kAdaptive ? nullptr
+                                                     : certificate_.get(),
+        choice.settings);
     cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
   };
   // The exact preconditioner's factorization, the longest step of this stage
@@ -156,7 +224,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   // computes the chordal one (which only reads the problem), and Initialize()
   // waits for it (its time is counted there).
   if (problem_->num_threads() > 1 &&
-      options.preconditioner == SolverOptions::Preconditioner::kRegularizedQ &&
+      choice.type == PreconditionerType::kRegularizedQ &&
       options.initialization == SolverOptions::Initialization::kChordal) {
     preconditioner_pending_ = std::async(std::launch::async, build);
   } else {
@@ -602,6 +670,7 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     s.extended_proof_time_s += verification_.extended_time_s;
     s.iterations += level.iterations;
     s.hessian_vector_products += level.hessian_vector_products;
+    s.preconditioner = PreconditionerName(*preconditioner_);
     s.optimization_time_s += level.optimize_time_s;
     s.verification_time_s += level.verify_time_s;
     s.levels.push_back(level);

@@ -139,7 +139,8 @@ void BindEnums(py::module_& m) {
   pre.value("none", O::Preconditioner::kNone)
       .value("block_jacobi", O::Preconditioner::kBlockJacobi)
       .value("sparse_cholesky", O::Preconditioner::kSparseCholesky)
-      .value("regularized_q", O::Preconditioner::kRegularizedQ);
+      .value("regularized_q", O::Preconditioner::kRegularizedQ)
+      .value("automatic", O::Preconditioner::kAutomatic);
   AcceptNames(pre);
   py::enum_<O::LocalSolver> local(m, "LocalSolver",
                                   "SolverOptions::LocalSolver");
@@ -252,6 +253,7 @@ void BindSolverSummary(py::module_& m) {
       .ro("lambda_min_estimate", &S::lambda_min_estimate)
       .ro("eta", &S::eta)
       .ro("proof_precision", &S::proof_precision)
+      .ro("preconditioner", &S::preconditioner)
       .ro("relaxation_exact", &S::relaxation_exact)
       .ro("final_rank", &S::final_rank)
       .ro("iterations", &S::iterations)

@@ -69,6 +69,15 @@ def test_options_by_keyword():
     s = cs.solve(g, initialization=cs.Initialization.random, seed=5, initial_rank=4, max_rank=4)
     assert s.objective == r.objective  # the same seed: the same solve
     assert cs.solve(g, preconditioner="block_jacobi").certified
+    # The default resolves by the exact factor's cost: exact on this cube,
+    # block-Jacobi on a city (SolverSummary::preconditioner says which).
+    assert cs.SolverOptions().preconditioner == cs.Preconditioner.automatic
+    assert cs.solve(g).preconditioner == "exact (Q + eps I)^-1"
+    city = cs.generate_city(num_poses=1000, seed=1)[0]
+    auto, exact = cs.solve(city), cs.solve(city, preconditioner="regularized_q")
+    assert auto.certified and auto.preconditioner == "block-Jacobi"
+    assert exact.certified and exact.preconditioner == "exact (Q + eps I)^-1"
+    assert abs(auto.objective - exact.objective) <= 1e-9 * exact.objective
     double = cs.solve(g, proof_arithmetic="double")
     assert double.certified and double.proof_precision == "double"
     assert double.extended_factorizations == 0
