@@ -81,6 +81,10 @@ DEFINE_string(poses_dir, "",
               "If set, write the SE-Sync solution and the initial guess of "
               "each dataset as g2o VERTEX files DATASET_sesync.g2o and "
               "DATASET_initial.g2o here (for plot_trajectory.py).");
+DEFINE_string(preconditioner, "auto",
+              "SE-Sync's truncated-CG preconditioner: auto "
+              "(SolverOptions::Preconditioner::kAutomatic, the default) or q "
+              "(kRegularizedQ, the exact one alone), for A/B runs.");
 DEFINE_bool(sesync_only, false,
             "Run only SE-Sync (for peak-memory measurements with "
             "/usr/bin/time -v); same as --methods sesync.");
@@ -342,6 +346,10 @@ bool BenchDataset(const std::string& path, int repeats,
     Poses sesync_poses;
     SolverOptions sesync_options;
     sesync_options.num_threads = FLAGS_num_threads;
+    if (FLAGS_preconditioner == "q") {
+      sesync_options.preconditioner =
+          SolverOptions::Preconditioner::kRegularizedQ;
+    }
     if (!RunSESync(graph, dataset, "SE-Sync", sesync_options, repeats,
                    /*extend=*/true, &sesync, &stage, &sesync_poses)) {
       return false;
@@ -484,6 +492,11 @@ int main(int argc, char** argv) {
       }
       methods.insert(method);
     }
+  }
+  if (FLAGS_preconditioner != "auto" && FLAGS_preconditioner != "q") {
+    std::fprintf(stderr, "bench: unknown --preconditioner '%s' (auto, q)\n",
+                 FLAGS_preconditioner.c_str());
+    return 2;
   }
   if (FLAGS_sesync_only) methods = {"sesync"};
   if (!FLAGS_lbfgs) methods.erase("lbfgs");
