@@ -72,17 +72,19 @@ struct SolverOptions {
     // (CHOLMOD's symbolic prediction of flops and entries at the initial
     // rank; deterministic), block-Jacobi, which switches to kRegularizedQ
     // for the rest of the solve once its truncated-CG iterations exceed 20
-    // times that ratio in all. Such factors are those of well-connected
-    // maps (2D cities 4-25, sphere2500 and cubicle 7.6, torus3D 11), where
-    // block-Jacobi needs 1.6-3x the Hessian-vector products (cubicle 4x,
-    // torus3D 11x) but each costs 3-5x less and nothing is factorized; on
-    // long trajectories (kitti_00, ais2klinik, CSAIL, intel, manhattan,
-    // parking-garage: ratios 0.5-2.2) it would need 10-180x the products.
-    // Measured (one thread, same results; bench/results/preconditioner_auto):
-    // city10000 0.65 -> 0.39 s, sphere2500 0.36 -> 0.19 s, 1000 to 10^5-pose
-    // cities 1.13-1.37x faster; cubicle 8% and torus3D 2% slower; with two
-    // threads a 10^5-pose city only 4% faster. SolverSummary::preconditioner
-    // says which one ran. Recommended.
+    // times that ratio in all, or at a saddle escape (the descent after one
+    // is long and flat: a 3x10^4-pose city at kappa 10, 2034 products, 1.13x
+    // faster than kRegularizedQ this way, 1.06x slower without). Such factors
+    // are those of well-connected maps (2D cities 4-25, sphere2500 and
+    // cubicle 7.6, torus3D 11), where block-Jacobi needs 1.6-3x the
+    // Hessian-vector products (cubicle 4x, torus3D 11x) but each costs 3-5x
+    // less and nothing is factorized; on long trajectories (kitti_00,
+    // ais2klinik, CSAIL, intel, manhattan, parking-garage: ratios 0.5-2.2) it
+    // would need 10-180x the products. Measured (one thread, same results;
+    // bench/results/preconditioner_auto): city10000 0.65 -> 0.39 s, sphere2500
+    // 0.36 -> 0.19 s, 1000 to 10^5-pose cities 1.13-1.37x faster; cubicle 8%
+    // and torus3D 2% slower; with two threads a 10^5-pose city only 4% faster.
+    // SolverSummary::preconditioner says which one ran. Recommended.
     kAutomatic,
   };
 

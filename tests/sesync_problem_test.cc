@@ -823,6 +823,17 @@ TEST(SESyncPreconditioner, AdaptiveSwitchesByItsRules) {
                                  max_condition);
   EXPECT_TRUE(converged.Update(0, true));
   EXPECT_TRUE(applies(converged, exact));
+  // On demand (the staircase at a saddle escape), once; kAdaptive only.
+  SESyncPreconditioner on_demand(problem, PreconditionerType::kAdaptive,
+                                 max_condition, nullptr, total);
+  EXPECT_TRUE(on_demand.SwitchToExact());
+  EXPECT_FALSE(on_demand.SwitchToExact());
+  EXPECT_EQ(on_demand.switches(), 1);
+  EXPECT_TRUE(applies(on_demand, exact));
+  SESyncPreconditioner block(problem, PreconditionerType::kBlockJacobi,
+                             max_condition);
+  EXPECT_FALSE(block.SwitchToExact());
+  EXPECT_TRUE(applies(block, block_jacobi));
 }
 
 }  // namespace

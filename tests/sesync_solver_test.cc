@@ -572,6 +572,13 @@ TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
   ASSERT_EQ(s_off.levels.size(), 2u) << "the fixture must escape a saddle";
   EXPECT_EQ(s_on.status, Status::kCertifiedOptimum) << s_on.FullReport();
   ASSERT_EQ(s_on.levels.size(), 2u) << s_on.FullReport();
+  // kAutomatic: block-Jacobi at the first level (this city's exact factor
+  // costs 4.1 applications of it; 63 products, within the budget of 82),
+  // the exact preconditioner from the escape on.
+  EXPECT_EQ(s_on.preconditioner,
+            "exact (Q + eps I)^-1 after " +
+                std::to_string(s_on.levels[0].hessian_vector_products) +
+                " block-Jacobi iterations");
   // No tests at the first level (not entered by an escape), none when off.
   EXPECT_EQ(s_on.levels[0].certificate_tests, 0);
   for (const SolverSummary::Level& level : s_off.levels) {

@@ -95,6 +95,14 @@ void SESyncPreconditioner::FactorizeRegularizedQ() {
   exact_ = true;
 }
 
+bool SESyncPreconditioner::SwitchToExact() {
+  if (type_ != PreconditionerType::kAdaptive || exact_) return false;
+  FactorizeRegularizedQ();
+  block_inverses_.resize(0, 0);
+  ++switches_;
+  return true;
+}
+
 bool SESyncPreconditioner::Update(int inner_iterations, bool converged) {
   if (type_ != PreconditionerType::kAdaptive || exact_) return false;
   block_jacobi_iterations_ += inner_iterations;
@@ -107,10 +115,7 @@ bool SESyncPreconditioner::Update(int inner_iterations, bool converged) {
       !long_total) {
     return false;
   }
-  FactorizeRegularizedQ();
-  block_inverses_.resize(0, 0);
-  ++switches_;
-  return true;
+  return SwitchToExact();
 }
 
 void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,

@@ -80,6 +80,9 @@ class SESyncPreconditioner {
   // returns true iff it switched (Apply() is then the exact operator from
   // now on).
   bool Update(int inner_iterations, bool converged);
+  // For kAdaptive (a no-op returning false otherwise): switches to the exact
+  // preconditioner now unless it already has; true iff it switched.
+  bool SwitchToExact();
   // Whether Apply() is (Q + eps I)^{-1} now, how often it switched, and the
   // truncated-CG iterations taken under block-Jacobi before that.
   bool exact() const { return exact_; }

@@ -631,6 +631,10 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     // Tests on the way only after an escape, and only where the level's
     // certificate is tested at all.
     const bool tested = verify_at_max_rank || r < options_.max_rank;
+    // kAutomatic's block-Jacobi ends at a saddle escape: the descent after
+    // one is long and flat (hundreds of products), where the exact
+    // preconditioner pays for its factorization.
+    if (r > first) preconditioner_->SwitchToExact();
     Optimize(r, /*test_certificate=*/r > first && tested, Y, &level);
     // Without the certificate tests' time (verify_time_s so far).
     level.optimize_time_s =
