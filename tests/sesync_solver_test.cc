@@ -201,6 +201,8 @@ TEST(SESyncSolver, AutomaticPreconditionerFollowsTheFactorCost) {
   std::string error;
   ASSERT_TRUE(GenerateCity(city, &city_graph, nullptr, &error)) << error;
   const PoseGraph cube = Cube(3, 5, 16.67, 75, 3);
+  EXPECT_EQ(SolverOptions().preconditioner,
+            SolverOptions::Preconditioner::kAutomatic);
   struct Case {
     const PoseGraph* graph;
     const char* expected;
@@ -211,8 +213,6 @@ TEST(SESyncSolver, AutomaticPreconditionerFollowsTheFactorCost) {
     automatic.num_threads = 1;
     SolverOptions exact = automatic;
     exact.preconditioner = SolverOptions::Preconditioner::kRegularizedQ;
-    EXPECT_EQ(SolverOptions().preconditioner,
-              SolverOptions::Preconditioner::kAutomatic);
     SolverSummary s_auto, s_exact;
     const Poses x_auto = Solve(*c.graph, automatic, &s_auto);
     const Poses x_exact = Solve(*c.graph, exact, &s_exact);

@@ -30,9 +30,9 @@ PreconditionerType ToInternal(SolverOptions::Preconditioner p) {
     case SolverOptions::Preconditioner::kRegularizedQ:
       return PreconditionerType::kRegularizedQ;
     case SolverOptions::Preconditioner::kAutomatic:
-      return PreconditionerType::kAdaptive;
+      break;  // Resolved by ChoosePreconditioner.
   }
-  return PreconditionerType::kNone;
+  return PreconditionerType::kRegularizedQ;
 }
 
 // SolverOptions::Preconditioner::kAutomatic: block-Jacobi (kAdaptive, with
@@ -47,9 +47,10 @@ PreconditionerType ToInternal(SolverOptions::Preconditioner p) {
 constexpr double kDenseFactorSolves = 3;
 // ... and block-Jacobi switches to the exact preconditioner once its
 // truncated-CG iterations exceed this multiple of that ratio in all (a
-// bound on what a wrong choice costs: roughly 10 factorizations' worth of
-// products). Block-Jacobi's own totals on the sets above: 4.9 (10^5-pose
-// city) to 19 (city10000) times the ratio; cubicle's 38.
+// bound on what a wrong choice costs: each block-Jacobi product costs 0.25-
+// 0.5 applications of the factor, so 5-10 factorizations' worth).
+// Block-Jacobi's own totals on the sets above: 4.9 (10^5-pose city) to 19
+// (city10000) times the ratio; cubicle's 38.
 constexpr double kBlockJacobiBudget = 20;
 
 struct PreconditionerChoice {
@@ -68,6 +69,7 @@ PreconditionerChoice ChoosePreconditioner(const SolverOptions& options,
     choice.type = PreconditionerType::kRegularizedQ;
     return choice;
   }
+  choice.type = PreconditionerType::kAdaptive;
   choice.settings.switch_iterations = 0;
   choice.settings.switch_at_convergence = false;
   choice.settings.switch_total_iterations =
