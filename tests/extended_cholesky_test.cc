@@ -175,7 +175,7 @@ std::vector<double> ResidualRowSums(const DoubleDoubleCholesky& chol,
                                     const Matrix& m) {
   const int n = m.n;
   const std::vector<int>& start = chol.factor_start();
-  const std::vector<int>& row = chol.factor_row();
+  const auto& row = chol.factor_row();
   const std::vector<DoubleDouble>& value = chol.factor_value();
   // Rows of L: (column, value) lists.
   std::vector<std::vector<std::pair<int, Quad>>> rows(n);

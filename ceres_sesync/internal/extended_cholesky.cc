@@ -593,8 +593,8 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   // the virtual machines measured, first touching fresh pages cost more than
   // this whole loop).
   factor_value_.clear();
-  std::vector<double>& super_hi = super_hi_;
-  std::vector<double>& super_lo = super_lo_;
+  HugePageVector<double>& super_hi = super_hi_;
+  HugePageVector<double>& super_lo = super_lo_;
   super_hi.assign(supernodal_entries(), 0.0);
   super_lo.assign(supernodal_entries(), 0.0);
   for (size_t p = 0; p < values.size(); ++p) {

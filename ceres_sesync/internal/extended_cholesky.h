@@ -45,6 +45,7 @@
 #include <vector>
 
 #include "ceres_sesync/internal/double_double.h"
+#include "ceres_sesync/internal/huge_page_allocator.h"
 #include "ceres_sesync/internal/tree_split.h"
 
 namespace ceres_sesync::internal {
@@ -104,7 +105,7 @@ class DoubleDoubleCholesky {
   // scheme keeps L in its dense blocks: factor_value() copies it out on its
   // first call after a factorization (for inspection and tests).
   const std::vector<int>& factor_start() const { return factor_start_; }
-  const std::vector<int>& factor_row() const { return factor_row_; }
+  const HugePageVector<int>& factor_row() const { return factor_row_; }
   const std::vector<DoubleDouble>& factor_value() const;
   // Multiply-adds of one factorization: sum over columns of count^2 / 2.
   double flops() const { return flops_; }
@@ -144,13 +145,13 @@ class DoubleDoubleCholesky {
   std::vector<int> column_start_, row_index_;  // The upper triangle of A.
   std::vector<int> parent_;                    // Elimination tree.
   std::vector<int> factor_start_;              // Column pointers of L.
-  std::vector<int> factor_row_;                // Row indices of L.
+  HugePageVector<int> factor_row_;             // Row indices of L.
   // Values of L (simplicial; for the supernodal scheme a copy made by
   // factor_value() on demand).
   mutable std::vector<DoubleDouble> factor_value_;
   // The supernodal scheme's dense blocks (see super_value_start_), which
   // hold L after a successful factorization.
-  std::vector<double> super_hi_, super_lo_;
+  HugePageVector<double> super_hi_, super_lo_;
   std::vector<int> row_count_;  // Entries per row of L.
   double flops_ = 0;
   bool factorized_ = false;
