@@ -115,7 +115,8 @@ class CertificateMatrix {
   double complete_double_seconds() const { return complete_double_seconds_; }
 
   // Factorizations so far, by arithmetic, and the seconds spent in the
-  // double-double ones (including their assembly and symbolic analysis).
+  // double-double ones (including their assembly and symbolic analysis,
+  // unless AnalyzeDoubleDouble() ran it ahead).
   int double_factorizations() const { return double_factorizations_; }
   int extended_factorizations() const { return extended_factorizations_; }
   double extended_time_s() const { return extended_time_s_; }
@@ -127,6 +128,14 @@ class CertificateMatrix {
   double FactorizationCostInSolves(int r) const {
     return factor_.analysis_flops() /
            (4.0 * r * std::max(1.0, factor_.analysis_nonzeros()));
+  }
+
+  // The double-double proofs' symbolic analysis (permuted pattern, elimination
+  // tree, supernodes), which the first of them runs otherwise; for running
+  // it ahead, concurrently with work that does not use this object. Not
+  // counted in extended_time_s().
+  void AnalyzeDoubleDouble() {
+    if (!extended_) InitializeDoubleDouble();
   }
 
   // Dimension dn of S.

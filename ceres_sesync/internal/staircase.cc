@@ -226,12 +226,24 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   // on the initial point: with a second thread it runs while Initialize()
   // computes the chordal one (which only reads the problem), and Initialize()
   // waits for it (its time is counted there).
-  if (problem_->num_threads() > 1 &&
-      choice.type == PreconditionerType::kRegularizedQ &&
-      options.initialization == SolverOptions::Initialization::kChordal) {
+  const bool parallel_window =
+      problem_->num_threads() > 1 &&
+      options.initialization == SolverOptions::Initialization::kChordal;
+  if (parallel_window && choice.type == PreconditionerType::kRegularizedQ) {
     preconditioner_pending_ = std::async(std::launch::async, build);
   } else {
     build();
+    // Block-Jacobi leaves the second thread idle during the chordal
+    // initialization: it runs the double-double proof's symbolic analysis
+    // (10^5-pose city: ~0.5 s, serial), which large maps, the ones that
+    // choose block-Jacobi, need for their first certificate (Verify()).
+    if (parallel_window &&
+        options.proof_arithmetic != SolverOptions::ProofArithmetic::kDouble) {
+      CertificateMatrix* certificate = certificate_.get();
+      preconditioner_pending_ = std::async(std::launch::async, [certificate] {
+        certificate->AnalyzeDoubleDouble();
+      });
+    }
   }
   SetScales();
   s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();

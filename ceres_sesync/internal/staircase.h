@@ -139,8 +139,9 @@ class Staircase {
                 double objective = 0, double gradient_norm = 0) const;
   // scale_ and zero_objective_ from the problem's current data.
   void SetScales();
-  // Waits for the preconditioner (and cost) built concurrently with
-  // Initialize() (see the constructor), if it is still being built.
+  // Waits for the work run concurrently with Initialize() (see the
+  // constructor): the preconditioner and cost, or the double-double
+  // analysis, if it is still running.
   void AwaitPreconditioner();
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
@@ -183,8 +184,9 @@ class Staircase {
   std::unique_ptr<CertificateMatrix> certificate_;
   std::unique_ptr<SESyncPreconditioner> preconditioner_;
   std::unique_ptr<SESyncCost> cost_;
-  // Builds preconditioner_ and cost_ on another thread (declared after what
-  // it uses, so that it is joined before they are destroyed).
+  // Builds preconditioner_ and cost_, or the certificate's double-double
+  // analysis, on another thread (declared after what it uses, so that it is
+  // joined before they are destroyed).
   std::future<void> preconditioner_pending_;
   VerificationResult verification_;
   double sdp_value_ = 0;
