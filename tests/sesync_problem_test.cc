@@ -19,8 +19,10 @@
 #include <vector>
 
 #include "Eigen/Dense"
+#include "ceres_sesync/city_generator.h"
 #include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/internal/sesync_cost.h"
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/pose_graph.h"
 #include "ceres_sesync/stiefel_manifold.h"
 #include "gtest/gtest.h"
@@ -651,6 +653,44 @@ TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
 // ReleaseNumericFactor() frees the values and keeps the symbolic analysis:
 // a copy taken before stays valid, and refactorizing (simplicial or
 // supernodal) gives the same factor to the last bit.
+// With two threads the vertex ordering is computed beside the assembly (at
+// 5000 vertices and more): the same permutation, and so bitwise the same
+// products, as with one thread; for a pose graph and for one with landmarks
+// and position priors (whose couplings the pattern must include).
+TEST(SESyncProblem, OrderingAndProductsDoNotDependOnThreadCount) {
+  CityOptions city;
+  city.num_poses = 6000;
+  city.seed = 3;
+  LandmarkGraphOptions landmarks;
+  landmarks.num_poses = 4000;
+  landmarks.num_landmarks = 3000;
+  landmarks.world_size = 200;
+  landmarks.sensor_range = 8;
+  landmarks.gps_interval = 50;
+  landmarks.seed = 4;
+  std::vector<PoseGraph> graphs(2);
+  ASSERT_TRUE(GenerateCity(city, &graphs[0], nullptr, nullptr));
+  ASSERT_TRUE(GenerateLandmarkGraph(landmarks, &graphs[1], nullptr, nullptr));
+  std::mt19937_64 rng(5);
+  for (const PoseGraph& graph : graphs) {
+    SESyncProblem serial(graph, 1), parallel(graph, 2);
+    ASSERT_TRUE(serial.ok() && parallel.ok());
+    const internal::ProblemLayout layout(graph);
+    ASSERT_GE(layout.num_vertices(), 5000);
+    std::vector<int> sorted = serial.vertex_ordering();
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<int> identity(layout.num_vertices());
+    std::iota(identity.begin(), identity.end(), 0);
+    EXPECT_EQ(sorted, identity);
+    EXPECT_EQ(serial.vertex_ordering(), parallel.vertex_ordering());
+    const MatrixXd Y = Gaussian(4, static_cast<int>(serial.D().cols()), &rng);
+    MatrixXd a, b;
+    serial.MultiplyQ(Y, &a);
+    parallel.MultiplyQ(Y, &b);
+    EXPECT_TRUE((a.array() == b.array()).all());
+  }
+}
+
 TEST(CholmodFactor, ReleaseKeepsAnalysisAndCopies) {
   std::mt19937_64 rng(41);
   for (const PoseGraph& graph : CostGraphs()) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -224,6 +225,95 @@ void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
   common.print = 0;
 }
 
+namespace {
+
+// The pattern of M collapsed to vertices (ProblemLayout): the terms of
+// L(W^tau), plus, with landmarks or priors, those of V and L(G^rho), which
+// are not all in it, and the diagonal. The terms, and so the pattern, do not
+// depend on the weights.
+std::vector<Triplet> VertexPattern(const PoseGraph& graph,
+                                   const ProblemLayout& layout) {
+  const int d = graph.dimension;
+  const bool more = graph.has_landmarks_or_priors();
+  std::vector<Triplet> pattern;
+  pattern.reserve(4 *
+                  (graph.measurements.size() +
+                   graph.landmark_measurements.size() + graph.priors.size()));
+  ForEachDataTerm<double>(
+      graph, [&](DataBlock block, int row, int col, double /*value*/) {
+        switch (block) {
+          case DataBlock::kTranslation:
+            pattern.emplace_back(row, col, 1.0);
+            return;
+          case DataBlock::kCoupling:
+            if (more) {
+              const int b = layout.vertex_of_rotation(col / d);
+              pattern.emplace_back(row, b, 1.0);
+              pattern.emplace_back(b, row, 1.0);
+            }
+            return;
+          case DataBlock::kRotation:
+            if (more) {
+              pattern.emplace_back(layout.vertex_of_rotation(row / d),
+                                   layout.vertex_of_rotation(col / d), 1.0);
+            }
+            return;
+          case DataBlock::kRotationSigma:
+            return;
+        }
+      });
+  if (more) {
+    for (int k = 0; k < layout.num_vertices(); ++k) {
+      pattern.emplace_back(k, k, 1.0);
+    }
+  }
+  return pattern;
+}
+
+// One fill-reducing ordering of the vertices (on VertexPattern) serves Lbar
+// and the augmented matrices of certificate_matrix.h, whose (d+1)-blocks
+// multiply its flops by about (d+1)^3 / 2. AMD is cheap; on large maps
+// nested dissection (METIS) costs more to compute but leaves much less
+// fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops (1.2x on
+// city10000 and a 27,000-pose cube). So METIS is tried when the predicted
+// flops of the augmented matrix exceed 2e4 per pose (about where its ~7 us
+// per pose pays off), and kept if it predicts fewer flops. The first
+// analysis is AMD alone: CHOLMOD's default would itself go on to METIS
+// when AMD's fill is heavy, which then ran twice (10^6-pose city: 9.9 s
+// for that analysis, 7.8 s for the second METIS).
+std::vector<int> VertexOrdering(const PoseGraph& graph,
+                                const ProblemLayout& layout) {
+  const int num_vertices = layout.num_vertices();
+  if (num_vertices == 1) return {0};
+  const std::vector<Triplet> vertex_pattern = VertexPattern(graph, layout);
+  SparseMatrix pattern(num_vertices, num_vertices);
+  pattern.setFromTriplets(vertex_pattern.begin(), vertex_pattern.end());
+  CholmodFactor analysis;
+  ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
+  analysis.cholmod().nmethods = 1;
+  analysis.cholmod().method[0].ordering = CHOLMOD_AMD;
+  analysis.analyzePattern(pattern);
+  std::vector<int> ordering = analysis.Ordering();
+  const double block_flops = std::pow(graph.dimension + 1.0, 3) / 2;
+  const double flops = analysis.cholmod().fl;
+  if (flops * block_flops > 2e4 * num_vertices) {
+    CholmodFactor nested;
+    ConfigureCholmod(CholmodLayout::kSimplicial, &nested);
+    cholmod_common& common = nested.cholmod();
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_METIS;
+    nested.analyzePattern(pattern);
+    if (nested.info() == Eigen::Success && nested.cholmod().fl < flops) {
+      ordering = nested.Ordering();
+    }
+    VLOG(1) << "vertex ordering: AMD " << flops << " flops, METIS "
+            << nested.cholmod().fl;
+  }
+  return ordering;
+}
+
+}  // namespace
+
 ProblemLayout::ProblemLayout(const PoseGraph& graph)
     : dimension(graph.dimension),
       num_poses(graph.num_poses),
@@ -243,52 +333,25 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
       n_(layout_.num_rotations()),
       num_threads_(std::max(1, num_threads)) {
   CHECK(weights_.empty() || weights_.size() == graph.measurements.size());
-  std::vector<Triplet> vertex_pattern;
-  Assemble(&vertex_pattern);
   const ProblemLayout& layout = layout_;
   const int N = layout.num_translations();
-  const int num_vertices = layout.num_vertices();
-  if (num_vertices == 1) {
-    vertex_ordering_ = {0};
+  // The ordering depends on the pattern alone: with a second thread it is
+  // computed while Assemble() computes the values (10^5-pose city: ~0.7 s
+  // each, the AMD and METIS analyses and the assembly; below ~5000 vertices
+  // both take a few ms, not worth a thread).
+  if (num_threads_ > 1 && layout.num_vertices() >= 5000) {
+    std::future<std::vector<int>> ordering =
+        std::async(std::launch::async,
+                   [&graph, &layout] { return VertexOrdering(graph, layout); });
+    Assemble();
+    vertex_ordering_ = ordering.get();
+  } else {
+    Assemble();
+    vertex_ordering_ = VertexOrdering(graph, layout);
+  }
+  if (layout.num_vertices() == 1) {
     ok_ = true;
     return;
-  }
-  // One fill-reducing ordering of the vertices (on the pattern of M
-  // collapsed to vertices: L(W^tau) for a pose graph) serves Lbar here and
-  // the augmented matrices of certificate_matrix.h, whose (d+1)-blocks
-  // multiply its flops by about (d+1)^3 / 2. AMD is cheap; on large maps
-  // nested dissection (METIS) costs more to compute but leaves much less
-  // fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops (1.2x on
-  // city10000 and a 27,000-pose cube). So METIS is tried when the predicted
-  // flops of the augmented matrix exceed 2e4 per pose (about where its ~7 us
-  // per pose pays off), and kept if it predicts fewer flops. The first
-  // analysis is AMD alone: CHOLMOD's default would itself go on to METIS
-  // when AMD's fill is heavy, which then ran twice (10^6-pose city: 9.9 s
-  // for that analysis, 7.8 s for the second METIS).
-  {
-    SparseMatrix pattern(num_vertices, num_vertices);
-    pattern.setFromTriplets(vertex_pattern.begin(), vertex_pattern.end());
-    CholmodFactor analysis;
-    ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
-    analysis.cholmod().nmethods = 1;
-    analysis.cholmod().method[0].ordering = CHOLMOD_AMD;
-    analysis.analyzePattern(pattern);
-    vertex_ordering_ = analysis.Ordering();
-    const double block_flops = std::pow(d_ + 1.0, 3) / 2;
-    const double flops = analysis.cholmod().fl;
-    if (flops * block_flops > 2e4 * num_vertices) {
-      CholmodFactor nested;
-      ConfigureCholmod(CholmodLayout::kSimplicial, &nested);
-      cholmod_common& common = nested.cholmod();
-      common.nmethods = 1;
-      common.method[0].ordering = CHOLMOD_METIS;
-      nested.analyzePattern(pattern);
-      if (nested.info() == Eigen::Success && nested.cholmod().fl < flops) {
-        vertex_ordering_ = nested.Ordering();
-      }
-      VLOG(1) << "vertex ordering: AMD " << flops << " flops, METIS "
-              << nested.cholmod().fl;
-    }
   }
   if (N == 1) {  // Nothing to factorize (one pose, rotation priors only).
     ok_ = true;
@@ -311,7 +374,7 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
   FactorizeLbar();
 }
 
-void SESyncProblem::Assemble(std::vector<Triplet>* vertex_pattern) {
+void SESyncProblem::Assemble() {
   const PoseGraph& graph = *graph_;
   const int d = d_, n = n_, N = layout_.num_translations();
   std::vector<Triplet> lrho, sigma, v, lw;
@@ -399,27 +462,6 @@ void SESyncProblem::Assemble(std::vector<Triplet>* vertex_pattern) {
   minus_Vbar_.makeCompressed();
   Lbar_.resize(N - 1, N - 1);
   Lbar_.setFromTriplets(lbar.begin(), lbar.end());
-  if (vertex_pattern) {
-    const int num_vertices = layout.num_vertices();
-    *vertex_pattern = lw;
-    if (graph.has_landmarks_or_priors()) {
-      // Rotation-only priors (L(G^rho)) and the couplings of landmarks and
-      // position priors to their rotations (V) are not all in L(W^tau).
-      for (const Triplet& t : v) {
-        const int a = t.row(), b = layout.vertex_of_rotation(t.col() / d);
-        vertex_pattern->emplace_back(a, b, 1.0);
-        vertex_pattern->emplace_back(b, a, 1.0);
-      }
-      for (const Triplet& t : lrho) {
-        vertex_pattern->emplace_back(layout.vertex_of_rotation(t.row() / d),
-                                     layout.vertex_of_rotation(t.col() / d),
-                                     1.0);
-      }
-      for (int k = 0; k < num_vertices; ++k) {
-        vertex_pattern->emplace_back(k, k, 1.0);
-      }
-    }
-  }
 }
 
 void SESyncProblem::FactorizeLbar() {
@@ -435,7 +477,7 @@ bool SESyncProblem::UpdateWeights(MeasurementWeights weights) {
   weights_ = std::move(weights);
   const Eigen::Index nnz_D = D_.nonZeros(), nnz_V = Vbar_.nonZeros(),
                      nnz_L = Lbar_.nonZeros();
-  Assemble(nullptr);
+  Assemble();
   // The patterns are functions of the graph alone (see Assemble()).
   CHECK(D_.nonZeros() == nnz_D && Vbar_.nonZeros() == nnz_V &&
         Lbar_.nonZeros() == nnz_L)

@@ -364,10 +364,8 @@ class SESyncProblem {
 
  private:
   // The values of every matrix and the rounding bounds from the current
-  // weights (the patterns are the same for all weights). `vertex_pattern`
-  // (if not null) gets the pattern of M collapsed to vertices (the terms of
-  // L(W^tau), plus those of landmarks and priors), for the ordering.
-  void Assemble(std::vector<Eigen::Triplet<double>>* vertex_pattern);
+  // weights (the patterns are the same for all weights).
+  void Assemble();
   // Numeric factorization of Lbar (symbolic analysis done); sets ok_.
   void FactorizeLbar();
 
