@@ -207,43 +207,41 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     s.message = "the translational Laplacian is not positive definite";
     return;
   }
-  certificate_ = std::make_unique<CertificateMatrix>(*problem_);
-  const PreconditionerChoice choice =
-      ChoosePreconditioner(options, *certificate_, r0_);
-  auto build = [this, choice] {
-    // kAdaptive switches in the first level (no certificate tests run during
-    // its optimization) or at an escape (between levels), so certificate_ is
-    // free then to serve as its workspace, as for kRegularizedQ (one symbolic
-    // analysis, the factor copied out and released: a workspace of its own
-    // cost the 10^6-pose city 3 GB of peak memory).
+  // The certificate matrix's symbolic analysis, the preconditioner's choice
+  // (from that analysis) and construction, and with block-Jacobi the
+  // double-double proof's symbolic analysis. None depends on the initial
+  // point: with a second thread they run while Initialize() computes the
+  // chordal one (which only reads the problem), and Initialize() waits for
+  // them (the wait is counted there). On the 10^5-pose city: the certificate
+  // analysis ~0.45 s, the exact preconditioner's factorization ~2 s, the
+  // double-double analysis ~0.5 s (which large maps, the ones that choose
+  // block-Jacobi, need for their first certificate).
+  const bool parallel_window =
+      problem_->num_threads() > 1 &&
+      options.initialization == SolverOptions::Initialization::kChordal;
+  auto prepare = [this, parallel_window] {
+    certificate_ = std::make_unique<CertificateMatrix>(*problem_);
+    const PreconditionerChoice choice =
+        ChoosePreconditioner(options_, *certificate_, r0_);
+    // kAdaptive switches in the first level (no certificate tests run
+    // during its optimization) or at an escape (between levels), so
+    // certificate_ is free then to serve as its workspace, as for
+    // kRegularizedQ (one symbolic analysis, the factor copied out and
+    // released: a workspace of its own cost the 10^6-pose city 3 GB of peak
+    // memory).
     preconditioner_ = std::make_unique<SESyncPreconditioner>(
         *problem_, choice.type, options_.regularized_cholesky_max_condition,
         certificate_.get(), choice.settings);
     cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
-  };
-  // The exact preconditioner's factorization, the longest step of this stage
-  // on large maps (10^5-pose city: ~2 s, single-threaded), does not depend
-  // on the initial point: with a second thread it runs while Initialize()
-  // computes the chordal one (which only reads the problem), and Initialize()
-  // waits for it (its time is counted there).
-  const bool parallel_window =
-      problem_->num_threads() > 1 &&
-      options.initialization == SolverOptions::Initialization::kChordal;
-  if (parallel_window && choice.type == PreconditionerType::kRegularizedQ) {
-    preconditioner_pending_ = std::async(std::launch::async, build);
-  } else {
-    build();
-    // Block-Jacobi leaves the second thread idle during the chordal
-    // initialization: it runs the double-double proof's symbolic analysis
-    // (10^5-pose city: ~0.5 s, serial), which large maps, the ones that
-    // choose block-Jacobi, need for their first certificate (Verify()).
-    if (parallel_window &&
-        options.proof_arithmetic != SolverOptions::ProofArithmetic::kDouble) {
-      CertificateMatrix* certificate = certificate_.get();
-      preconditioner_pending_ = std::async(std::launch::async, [certificate] {
-        certificate->AnalyzeDoubleDouble();
-      });
+    if (parallel_window && choice.type != PreconditionerType::kRegularizedQ &&
+        options_.proof_arithmetic != SolverOptions::ProofArithmetic::kDouble) {
+      certificate_->AnalyzeDoubleDouble();
     }
+  };
+  if (parallel_window) {
+    preconditioner_pending_ = std::async(std::launch::async, prepare);
+  } else {
+    prepare();
   }
   SetScales();
   s.data_time_s = std::chrono::duration<double>(Clock::now() - t).count();
