@@ -1,6 +1,8 @@
 #include "ceres_sesync/chordal_initialization.h"
 
 #include <algorithm>
+#include <array>
+#include <complex>
 #include <numeric>
 #include <vector>
 
@@ -42,6 +44,57 @@ std::vector<Eigen::MatrixXd> AlignComponents(const Eigen::MatrixXd& A, int d,
   return G;
 }
 
+// For d = 2 the blocks of L(G^rho) are kappa-weighted sums of rotations
+// [[c, -s], [s, c]], i.e. the real form of complex numbers c + i s, and the
+// chordal problem is the complex Hermitian system of size n_free (Z x = b)
+// instead of the real one of size 2 n_free: a quarter of the factor's real
+// entries' work (4 real flops per complex one, against 2 x 2 blocks of 4
+// entries each), ~2x fewer flops in all. Fills Z and b (the anchors' column
+// sums, -sum_a Z_ka) if every block is exactly of that form (entries (0, 0)
+// = (1, 1) and (0, 1) = -(1, 0), bitwise; absent entries are 0); else
+// returns false (a graph with rotations given as general 2 x 2 matrices) and
+// the caller solves the real system, as for d = 3.
+bool ComplexChordalSystem(const SparseMatrix& L,
+                          const std::vector<int>& free_index, int num_free,
+                          ComplexSparseMatrix* Z, Eigen::VectorXcd* b) {
+  const int n = static_cast<int>(L.cols()) / 2;
+  std::vector<std::array<double, 4>> block(n, {0, 0, 0, 0});
+  std::vector<int> touched;
+  std::vector<char> seen(n, 0);
+  std::vector<Eigen::Triplet<std::complex<double>>> triplets;
+  triplets.reserve(L.nonZeros() / 4 + n);
+  b->setZero(num_free);
+  for (int j = 0; j < n; ++j) {
+    // Gather block column j: entry (r % 2) + 2 (c % 2) of block r / 2.
+    for (int c = 2 * j; c < 2 * j + 2; ++c) {
+      for (SparseMatrix::InnerIterator it(L, c); it; ++it) {
+        const int i = static_cast<int>(it.row()) / 2;
+        if (!seen[i]) {
+          seen[i] = 1;
+          touched.push_back(i);
+        }
+        block[i][it.row() % 2 + 2 * (c % 2)] = it.value();
+      }
+    }
+    bool complex_form = true;
+    for (int i : touched) {
+      const std::array<double, 4>& v = block[i];
+      complex_form = complex_form && v[0] == v[3] && v[2] == -v[1];
+      const std::complex<double> z(v[0], v[1]);
+      const int fr = free_index[i], fc = free_index[j];
+      if (fr >= 0 && fc >= 0 && fr >= fc) triplets.emplace_back(fr, fc, z);
+      if (fr >= 0 && fc < 0) (*b)(fr) -= z;
+      block[i] = {0, 0, 0, 0};
+      seen[i] = 0;
+    }
+    touched.clear();
+    if (!complex_form) return false;
+  }
+  Z->resize(num_free, num_free);
+  Z->setFromTriplets(triplets.begin(), triplets.end());
+  return true;
+}
+
 }  // namespace
 
 bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
@@ -80,9 +133,53 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
     if (free_index[i] < 0) R->middleCols(d * i, d).setIdentity();
   }
   if (num_free == 0) return true;
+  // The fill-reducing ordering of the free blocks, if given for all.
+  std::vector<int> block_order;
+  if (block_ordering != nullptr) {
+    std::vector<char> seen(n, 0);
+    block_order.reserve(num_free);
+    for (int block : *block_ordering) {
+      if (block < 0 || block >= n || seen[block] || free_index[block] < 0) {
+        continue;
+      }
+      seen[block] = 1;
+      block_order.push_back(free_index[block]);
+    }
+    if (static_cast<int>(block_order.size()) != num_free) block_order.clear();
+  }
   // With R = [I .. I (anchors), X]: minimize tr(X L_ff X^T) + 2 tr(L_fa A
   // X^T), i.e. solve L_ff X^T = -L_fa A (L_ff is positive definite when
   // every component is connected through nonzero blocks).
+  if (d == 2) {
+    ComplexSparseMatrix Z;
+    Eigen::VectorXcd b;
+    if (ComplexChordalSystem(L, free_index, num_free, &Z, &b)) {
+      ComplexCholmodFactor factor;
+      ConfigureCholmod(CholmodLayout::kAutomatic, &factor);
+      if (static_cast<int>(block_order.size()) == num_free) {
+        factor.AnalyzePatternWithOrdering(Z, block_order);
+      } else {
+        factor.analyzePattern(Z);
+      }
+      factor.factorize(Z);
+      if (factor.info() != Eigen::Success) return false;
+      const Eigen::VectorXcd x = factor.solve(b);
+      // The real form of x: block k of X^T is [[Re, -Im], [Im, Re]] x_k.
+      Eigen::MatrixXd X(2, 2 * num_free);
+      for (int k = 0; k < num_free; ++k) {
+        X(0, 2 * k) = X(1, 2 * k + 1) = x(k).real();
+        X(0, 2 * k + 1) = x(k).imag();
+        X(1, 2 * k) = -x(k).imag();
+      }
+      X = ProjectBlocksToRotations(X, d);
+      for (int i = 0; i < n; ++i) {
+        if (free_index[i] >= 0) {
+          R->middleCols(2 * i, 2) = X.middleCols(2 * free_index[i], 2);
+        }
+      }
+      return true;
+    }
+  }
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(L.nonZeros());
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(d * num_free, d);
@@ -105,16 +202,9 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
   CholmodFactor factor;
   ConfigureCholmod(CholmodLayout::kAutomatic, &factor);
   std::vector<int> ordering;
-  if (block_ordering != nullptr) {
-    std::vector<char> seen(n, 0);
-    ordering.reserve(d * num_free);
-    for (int block : *block_ordering) {
-      if (block < 0 || block >= n || seen[block] || free_index[block] < 0) {
-        continue;
-      }
-      seen[block] = 1;
-      for (int a = 0; a < d; ++a) ordering.push_back(d * free_index[block] + a);
-    }
+  ordering.reserve(d * block_order.size());
+  for (int k : block_order) {
+    for (int a = 0; a < d; ++a) ordering.push_back(d * k + a);
   }
   if (static_cast<int>(ordering.size()) == d * num_free) {
     factor.AnalyzePatternWithOrdering(L_ff, std::move(ordering));

@@ -79,15 +79,29 @@ TEST(ChordalInitialization, NoiselessGraphsAreRecoveredExactly) {
 // On noisy data: the output rotations are in SO(d), and they are the blockwise
 // projections of the dense least-squares solution of
 // min sum kappa ||R_j - R_i R~||^2 with R_0 = I (computed densely here).
+// In 2D the chordal system is solved in complex form when every rotation
+// block is exactly [[c, -s], [s, c]] (the graphs read or generated), and in
+// real form otherwise (variant 20: rotations one ulp away from that form).
 TEST(ChordalInitialization, NoisyGraphsMatchDenseLeastSquares) {
-  for (int d : {2, 3}) {
+  for (int variant : {2, 3, 20}) {
+    const int d = variant == 3 ? 3 : 2;
     RandomGraphOptions o;
     o.dimension = d;
     o.num_poses = 30;
     o.num_loop_closures = 25;
     o.kappa = 2;  // Strong noise.
     o.seed = 99 + d;
-    const PoseGraph graph = test_util::RandomPoseGraph(o, nullptr);
+    PoseGraph graph = test_util::RandomPoseGraph(o, nullptr);
+    if (d == 2) {
+      // The test graphs' rotations are products: make them exactly of the
+      // form read from files, then (variant 20) move one entry by an ulp.
+      for (auto& e : graph.measurements) {
+        const double theta = std::atan2(e.R(1, 0), e.R(0, 0));
+        e.R << std::cos(theta), -std::sin(theta), std::sin(theta),
+            std::cos(theta);
+        if (variant == 20) e.R(1, 1) = std::nextafter(e.R(1, 1), 2.0);
+      }
+    }
     MatrixXd R;
     std::string error;
     ASSERT_TRUE(ChordalRotations(graph, &R, &error)) << error;

@@ -156,11 +156,6 @@ void CholmodFactor::BackwardErrorBound(int split, double* head_bound,
   }
 }
 
-void CholmodFactor::factorize(const SparseMatrix& matrix) {
-  ScopedSerialOpenMpTeams serial_teams;
-  Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>::factorize(matrix);
-}
-
 SparseCholeskyFactor CholmodFactor::ExtractFactor() {
   return SparseCholeskyFactor(m_cholmodFactor, &cholmod());
 }
@@ -175,31 +170,6 @@ void CholmodFactor::ReleaseNumericFactor() {
   m_factorizationIsOk = false;
 }
 
-void CholmodFactor::AnalyzePatternWithOrdering(const SparseMatrix& lower,
-                                               std::vector<int> ordering) {
-  CHECK_EQ(static_cast<int>(ordering.size()), lower.rows());
-  cholmod_common& common = cholmod();
-  if (m_cholmodFactor != nullptr) {
-    cholmod_free_factor(&m_cholmodFactor, &common);
-  }
-  cholmod_sparse A =
-      Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
-  const int saved_methods = common.nmethods;
-  const int saved_ordering = common.method[0].ordering;
-  common.nmethods = 1;
-  common.method[0].ordering = CHOLMOD_GIVEN;
-  m_cholmodFactor = cholmod_analyze_p(&A, ordering.data(), nullptr, 0, &common);
-  common.nmethods = saved_methods;
-  common.method[0].ordering = saved_ordering;
-  CHECK(m_cholmodFactor != nullptr) << "cholmod_analyze_p failed";
-  analysis_flops_ = common.fl;
-  analysis_nonzeros_ = common.lnz;
-  m_isInitialized = true;
-  m_info = Eigen::Success;
-  m_analysisIsOk = true;
-  m_factorizationIsOk = false;
-}
-
 std::vector<int> CholmodFactor::Ordering() const {
   CHECK(m_cholmodFactor != nullptr);
   const int* perm = static_cast<const int*>(m_cholmodFactor->Perm);
@@ -209,20 +179,6 @@ std::vector<int> CholmodFactor::Ordering() const {
 bool CholmodFactor::IsSupernodal() const {
   CHECK(m_cholmodFactor != nullptr);
   return m_cholmodFactor->is_super;
-}
-
-void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor) {
-  factor->setMode(layout == CholmodLayout::kSimplicial
-                      ? Eigen::CholmodSimplicialLLt
-                      : Eigen::CholmodSupernodalLLt);
-  cholmod_common& common = factor->cholmod();
-  if (layout == CholmodLayout::kAutomatic) {
-    common.supernodal = CHOLMOD_AUTO;
-    common.supernodal_switch = kSupernodalSwitch;
-  }
-  // A simplicial factorization is computed as LL^T (not LDL^T) iff final_ll.
-  common.final_ll = 1;
-  common.print = 0;
 }
 
 namespace {

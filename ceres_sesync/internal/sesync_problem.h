@@ -27,6 +27,7 @@
 #ifndef CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
 #define CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
 
+#include <complex>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -35,21 +36,77 @@
 #include "Eigen/Core"
 #include "Eigen/SparseCore"
 #include "ceres_sesync/internal/measurement_weights.h"
+#include "ceres_sesync/internal/openmp_teams.h"
 #include "ceres_sesync/internal/sparse_cholesky_factor.h"
 #include "ceres_sesync/pose_graph.h"
+#include "glog/logging.h"
 
 namespace ceres_sesync::internal {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using ComplexSparseMatrix =
+    Eigen::SparseMatrix<std::complex<double>, Eigen::ColMajor, int>;
+
+// Eigen's CHOLMOD LL^T (LL^H for complex) decomposition of the lower
+// triangle, with two additions: numeric factorizations run CHOLMOD's OpenMP
+// teams with one thread (openmp_teams.h: supernodal factorizations up to 2x
+// faster, the same factor), and the symbolic analysis can take a
+// fill-reducing ordering from the caller.
+template <typename Matrix>
+class CholmodDecompositionWithOrdering
+    : public Eigen::CholmodDecomposition<Matrix, Eigen::Lower> {
+  using Base = Eigen::CholmodDecomposition<Matrix, Eigen::Lower>;
+
+ public:
+  void factorize(const Matrix& matrix) {
+    ScopedSerialOpenMpTeams serial_teams;
+    Base::factorize(matrix);
+  }
+  // analyzePattern() with a fill-reducing ordering chosen by the caller
+  // (ordering[k] = original index of the k-th pivot) instead of CHOLMOD's
+  // own (AMD, possibly METIS) on the full matrix.
+  void AnalyzePatternWithOrdering(const Matrix& lower,
+                                  std::vector<int> ordering) {
+    CHECK_EQ(static_cast<int>(ordering.size()), lower.rows());
+    cholmod_common& common = this->cholmod();
+    if (this->m_cholmodFactor != nullptr) {
+      cholmod_free_factor(&this->m_cholmodFactor, &common);
+    }
+    cholmod_sparse A =
+        Eigen::viewAsCholmod(lower.template selfadjointView<Eigen::Lower>());
+    const int saved_methods = common.nmethods;
+    const int saved_ordering = common.method[0].ordering;
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_GIVEN;
+    this->m_cholmodFactor =
+        cholmod_analyze_p(&A, ordering.data(), nullptr, 0, &common);
+    common.nmethods = saved_methods;
+    common.method[0].ordering = saved_ordering;
+    CHECK(this->m_cholmodFactor != nullptr) << "cholmod_analyze_p failed";
+    analysis_flops_ = common.fl;
+    analysis_nonzeros_ = common.lnz;
+    this->m_isInitialized = true;
+    this->m_info = Eigen::Success;
+    this->m_analysisIsOk = true;
+    this->m_factorizationIsOk = false;
+  }
+  // After AnalyzePatternWithOrdering(): CHOLMOD's predicted flop count of a
+  // factorization and the number of nonzeros of L.
+  double analysis_flops() const { return analysis_flops_; }
+  double analysis_nonzeros() const { return analysis_nonzeros_; }
+
+ private:
+  double analysis_flops_ = 0, analysis_nonzeros_ = 0;
+};
+
+// The 2D chordal initialization's complex Hermitian systems (chordal.h).
+using ComplexCholmodFactor =
+    CholmodDecompositionWithOrdering<ComplexSparseMatrix>;
+
 // CHOLMOD's Cholesky factorization (through Eigen) plus an a posteriori bound
 // on its floating-point backward error.
-class CholmodFactor
-    : public Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> {
+class CholmodFactor : public CholmodDecompositionWithOrdering<SparseMatrix> {
  public:
-  // Eigen's numeric factorization, with CHOLMOD's OpenMP teams of one thread
-  // (openmp_teams.h): supernodal factorizations up to 2x faster, the same
-  // factor.
-  void factorize(const SparseMatrix& matrix);
   // After a successful LL^T factorization P A P^T = L L^T + E: bounds on the
   // floating-point backward error E such that
   //   A + diag(head_bound I, tail_bound I) is positive semidefinite,
@@ -76,23 +133,11 @@ class CholmodFactor
   bool HasNumericFactor() const {
     return m_cholmodFactor != nullptr && m_factorizationIsOk;
   }
-  // analyzePattern() with a fill-reducing ordering chosen by the caller
-  // (ordering[k] = original index of the k-th pivot) instead of CHOLMOD's
-  // own (AMD, possibly METIS) on the full matrix.
-  void AnalyzePatternWithOrdering(const SparseMatrix& lower,
-                                  std::vector<int> ordering);
   // After analyzePattern(): CHOLMOD's fill-reducing ordering.
   std::vector<int> Ordering() const;
   // After analyzePattern(): whether CHOLMOD chose the supernodal layout
   // (dense fill, expensive factorizations).
   bool IsSupernodal() const;
-  // After AnalyzePatternWithOrdering(): CHOLMOD's predicted flop count of a
-  // factorization and the number of nonzeros of L.
-  double analysis_flops() const { return analysis_flops_; }
-  double analysis_nonzeros() const { return analysis_nonzeros_; }
-
- private:
-  double analysis_flops_ = 0, analysis_nonzeros_ = 0;
 };
 
 // How CHOLMOD organizes the factor. Simplicial: fast for sparse factors and
@@ -110,7 +155,21 @@ constexpr double kSupernodalSwitch = 200;
 // Sets a true LL^T factorization in every layout (which fails on matrices
 // that are not positive definite, unlike LDL^T) and silences CHOLMOD's own
 // printing (failures are reported through info()).
-void ConfigureCholmod(CholmodLayout layout, CholmodFactor* factor);
+template <typename Matrix>
+void ConfigureCholmod(CholmodLayout layout,
+                      CholmodDecompositionWithOrdering<Matrix>* factor) {
+  factor->setMode(layout == CholmodLayout::kSimplicial
+                      ? Eigen::CholmodSimplicialLLt
+                      : Eigen::CholmodSupernodalLLt);
+  cholmod_common& common = factor->cholmod();
+  if (layout == CholmodLayout::kAutomatic) {
+    common.supernodal = CHOLMOD_AUTO;
+    common.supernodal_switch = kSupernodalSwitch;
+  }
+  // A simplicial factorization is computed as LL^T (not LDL^T) iff final_ll.
+  common.final_ll = 1;
+  common.print = 0;
+}
 
 // The index sets of the unknowns (see the top of this file):
 //   translation nodes  k = 0..n-1       pose translations t_k,
