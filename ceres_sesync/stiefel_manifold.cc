@@ -12,6 +12,7 @@
 #include "Eigen/LU"
 #include "Eigen/QR"
 #include "Eigen/SVD"
+#include "ceres_sesync/internal/parallel.h"
 
 namespace ceres_sesync {
 namespace {
@@ -599,16 +600,26 @@ Eigen::MatrixXd SymBlockDiagProduct(const Eigen::MatrixXd& A,
 
 void ProjectToStiefelProductTangent(const Eigen::MatrixXd& Y,
                                     const Eigen::MatrixXd& V, int d,
-                                    Eigen::MatrixXd* out) {
+                                    Eigen::MatrixXd* out, int num_threads) {
   if (out == nullptr) return;
   if (!SameProductShape(Y, V, d) || Y.rows() < d || out == &Y) {
     out->resize(0, 0);
     return;
   }
   const int n = static_cast<int>(Y.cols() / d);
+  const int r = static_cast<int>(Y.rows());
   out->resize(Y.rows(), Y.cols());  // No-op (keeps data) when out == &V.
-  CERES_SESYNC_DISPATCH_ON_D(d, TangentProjectionDispatch, Y.data(), V.data(),
-                             static_cast<int>(Y.rows()), d, n, out->data());
+  const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(r) * d;
+  internal::ParallelParts(
+      internal::ThreadsForPass(num_threads, static_cast<double>(Y.size())),
+      [&](int part, int parts) {
+        const int begin = internal::PartBegin(n, part, parts);
+        const int end = internal::PartBegin(n, part + 1, parts);
+        CERES_SESYNC_DISPATCH_ON_D(d, TangentProjectionDispatch,
+                                   Y.data() + begin * stride,
+                                   V.data() + begin * stride, r, d, end - begin,
+                                   out->data() + begin * stride);
+      });
 }
 
 void RetractStiefelProduct(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,

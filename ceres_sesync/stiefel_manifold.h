@@ -76,10 +76,12 @@ Eigen::MatrixXd SymBlockDiagProduct(const Eigen::MatrixXd& A,
 // Orthogonal projection onto the tangent space of St(d, r)^n at Y, eq. (42)
 // of Rosen et al. 2019:
 //   out = V - Y SymBlockDiag_d(Y^T V)   (blockwise),
-// so that Y_i^T out_i + out_i^T Y_i = 0. `out` may alias V (not Y).
+// so that Y_i^T out_i + out_i^T Y_i = 0. `out` may alias V (not Y). Large
+// products are split over up to `num_threads` threads by blocks (the same
+// results for any thread count).
 void ProjectToStiefelProductTangent(const Eigen::MatrixXd& Y,
                                     const Eigen::MatrixXd& V, int d,
-                                    Eigen::MatrixXd* out);
+                                    Eigen::MatrixXd* out, int num_threads = 1);
 
 // Polar retraction, blockwise:
 //   out_i = (Y_i + V_i) (I + V_i^T V_i)^(-1/2) = polar factor of (Y_i + V_i).

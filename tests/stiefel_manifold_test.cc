@@ -12,6 +12,7 @@
 #include "Eigen/Dense"
 #include "ceres/ceres.h"
 #include "ceres/manifold_test_utils.h"
+#include "ceres_sesync/internal/sesync_problem.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -591,6 +592,39 @@ TEST(StiefelProductManifold, CeresSolveFindsNearestOrthogonalMatrices) {
   // reachable accuracy is about sqrt(eps * cost / curvature) ~ 1e-10 here
   // (measured: 3e-11); 1e-8 per entry, as the brief asks, leaves a margin.
   EXPECT_LT((y - expected).cwiseAbs().maxCoeff(), 1e-8) << summary.FullReport();
+}
+
+// Products large enough to be split over threads (> 2^19 entries): bitwise
+// the same with one and two threads, also in place (out aliasing V), and
+// each block the serial formula's.
+TEST(StiefelProduct, BlockwisePassesDoNotDependOnThreadCount) {
+  std::mt19937_64 rng(17);
+  for (int d : {2, 3}) {
+    const int r = d + 2, n = (1 << 19) / (r * d) + 1000;
+    const MatrixXd Y = RandomStiefelProductPoint(d, r, n, &rng);
+    const MatrixXd V = MatrixXd::Random(r, d * n);
+    const MatrixXd Lambda = MatrixXd::Random(d, d * n);
+    MatrixXd one, two, in_place = V;
+    ProjectToStiefelProductTangent(Y, V, d, &one, 1);
+    ProjectToStiefelProductTangent(Y, V, d, &two, 2);
+    ProjectToStiefelProductTangent(Y, in_place, d, &in_place, 2);
+    EXPECT_TRUE((one.array() == two.array()).all()) << "d = " << d;
+    EXPECT_TRUE((one.array() == in_place.array()).all()) << "d = " << d;
+    for (int i : {0, n / 2, n - 1}) {
+      const MatrixXd Yi = Y.middleCols(d * i, d), Vi = V.middleCols(d * i, d);
+      const MatrixXd YtV = Yi.transpose() * Vi;
+      const MatrixXd expected = Vi - Yi * (0.5 * (YtV + YtV.transpose()));
+      EXPECT_LT((one.middleCols(d * i, d) - expected).norm(), 1e-13);
+    }
+    internal::BlockDiagonalMultiply(V, Lambda, d, &one, 1);
+    internal::BlockDiagonalMultiply(V, Lambda, d, &two, 2);
+    EXPECT_TRUE((one.array() == two.array()).all()) << "d = " << d;
+    for (int i : {0, n / 2, n - 1}) {
+      const MatrixXd expected =
+          V.middleCols(d * i, d) * Lambda.middleCols(d * i, d);
+      EXPECT_LT((one.middleCols(d * i, d) - expected).norm(), 1e-13);
+    }
+  }
 }
 
 }  // namespace

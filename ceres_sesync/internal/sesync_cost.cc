@@ -125,7 +125,7 @@ void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
       *X = V;
       return;
     case PreconditionerType::kBlockJacobi:
-      BlockDiagonalMultiply(V, block_inverses_, d_, X);
+      BlockDiagonalMultiply(V, block_inverses_, d_, X, num_threads_);
       return;
     case PreconditionerType::kSparseCholesky:
       factor_.SolveRows(V, X, num_threads_);
@@ -137,7 +137,7 @@ void SESyncPreconditioner::Apply(const Eigen::MatrixXd& V,
       if (exact_) {
         factor_.SolveRowsTail(V, translation_size_, X, num_threads_);
       } else {
-        BlockDiagonalMultiply(V, block_inverses_, d_, X);
+        BlockDiagonalMultiply(V, block_inverses_, d_, X, num_threads_);
       }
       return;
   }
@@ -158,7 +158,7 @@ double SESyncCost::Evaluate(const Eigen::MatrixXd& Y) {
 
 void SESyncCost::Gradient(Eigen::MatrixXd* gradient) {
   // Proj_Y(2 Y Q) = 2 (Y Q - Y_i Lambda_i), eq. (43).
-  BlockDiagonalMultiply(Y_, lambda_, d_, gradient);
+  BlockDiagonalMultiply(Y_, lambda_, d_, gradient, problem_->num_threads());
   *gradient = 2 * (YQ_ - *gradient);
 }
 
@@ -166,14 +166,14 @@ void SESyncCost::HessianVector(const Eigen::MatrixXd& V, Eigen::MatrixXd* hv) {
   // Eq. (44): Proj_Y(2 V Q - V_i SymBlockDiag(Y^T 2 Y Q)_i).
   ++hessian_vector_products_;
   problem_->MultiplyQ(V, &vq_);
-  BlockDiagonalMultiply(V, lambda_, d_, &v_lambda_);
+  BlockDiagonalMultiply(V, lambda_, d_, &v_lambda_, problem_->num_threads());
   vq_ = 2 * (vq_ - v_lambda_);
-  ProjectToStiefelProductTangent(Y_, vq_, d_, hv);
+  ProjectToStiefelProductTangent(Y_, vq_, d_, hv, problem_->num_threads());
 }
 
 void SESyncCost::Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) {
   preconditioner_->Apply(V, &vq_);
-  ProjectToStiefelProductTangent(Y_, vq_, d_, pv);
+  ProjectToStiefelProductTangent(Y_, vq_, d_, pv, problem_->num_threads());
 }
 
 bool SESyncCost::UpdatePreconditioner(int inner_iterations, bool converged) {
@@ -187,7 +187,7 @@ void SESyncCost::Retract(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V,
 
 void SESyncCost::ProjectToTangent(const Eigen::MatrixXd& V,
                                   Eigen::MatrixXd* result) {
-  ProjectToStiefelProductTangent(Y_, V, d_, result);
+  ProjectToStiefelProductTangent(Y_, V, d_, result, problem_->num_threads());
 }
 
 }  // namespace ceres_sesync::internal

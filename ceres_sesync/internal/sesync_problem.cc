@@ -484,14 +484,13 @@ namespace {
 
 template <int R, int D>
 void BlockDiagonalKernel(const Eigen::MatrixXd& V,
-                         const Eigen::MatrixXd& Lambda, int d,
-                         Eigen::MatrixXd* out) {
+                         const Eigen::MatrixXd& Lambda, int d, int begin,
+                         int end, Eigen::MatrixXd* out) {
   using Block = Eigen::Matrix<double, R, D>;
   using Small = Eigen::Matrix<double, D, D>;
   const int r = static_cast<int>(V.rows());
-  const int n = static_cast<int>(V.cols() / d);
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(r) * d;
-  for (int i = 0; i < n; ++i) {
+  for (int i = begin; i < end; ++i) {
     Eigen::Map<Block>(out->data() + i * stride, r, d).noalias() =
         Eigen::Map<const Block>(V.data() + i * stride, r, d)
             .lazyProduct(Eigen::Map<const Small>(
@@ -501,31 +500,42 @@ void BlockDiagonalKernel(const Eigen::MatrixXd& V,
 
 template <int D>
 void BlockDiagonalDispatch(const Eigen::MatrixXd& V,
-                           const Eigen::MatrixXd& Lambda, int d,
-                           Eigen::MatrixXd* out) {
+                           const Eigen::MatrixXd& Lambda, int d, int begin,
+                           int end, Eigen::MatrixXd* out) {
   if constexpr (D != Eigen::Dynamic) {
     switch (V.rows()) {
       case D + 1:
-        return BlockDiagonalKernel<D + 1, D>(V, Lambda, d, out);
+        return BlockDiagonalKernel<D + 1, D>(V, Lambda, d, begin, end, out);
       case D + 2:
-        return BlockDiagonalKernel<D + 2, D>(V, Lambda, d, out);
+        return BlockDiagonalKernel<D + 2, D>(V, Lambda, d, begin, end, out);
       case D + 3:
-        return BlockDiagonalKernel<D + 3, D>(V, Lambda, d, out);
+        return BlockDiagonalKernel<D + 3, D>(V, Lambda, d, begin, end, out);
     }
   }
-  BlockDiagonalKernel<Eigen::Dynamic, D>(V, Lambda, d, out);
+  BlockDiagonalKernel<Eigen::Dynamic, D>(V, Lambda, d, begin, end, out);
 }
 
 }  // namespace
 
 void BlockDiagonalMultiply(const Eigen::MatrixXd& V,
                            const Eigen::MatrixXd& Lambda, int d,
-                           Eigen::MatrixXd* out) {
+                           Eigen::MatrixXd* out, int num_threads) {
   DCHECK(out != &V);
   out->resize(V.rows(), V.cols());
-  if (d == 2) return BlockDiagonalDispatch<2>(V, Lambda, d, out);
-  if (d == 3) return BlockDiagonalDispatch<3>(V, Lambda, d, out);
-  BlockDiagonalDispatch<Eigen::Dynamic>(V, Lambda, d, out);
+  const int n = static_cast<int>(V.cols() / d);
+  ParallelParts(ThreadsForPass(num_threads, static_cast<double>(V.size())),
+                [&](int part, int parts) {
+                  const int begin = PartBegin(n, part, parts);
+                  const int end = PartBegin(n, part + 1, parts);
+                  if (d == 2) {
+                    BlockDiagonalDispatch<2>(V, Lambda, d, begin, end, out);
+                  } else if (d == 3) {
+                    BlockDiagonalDispatch<3>(V, Lambda, d, begin, end, out);
+                  } else {
+                    BlockDiagonalDispatch<Eigen::Dynamic>(V, Lambda, d, begin,
+                                                          end, out);
+                  }
+                });
 }
 
 }  // namespace ceres_sesync::internal

@@ -444,10 +444,11 @@ class SESyncProblem {
 double BlockDiagonalTrace(const Eigen::MatrixXd& Lambda, int d);
 
 // out_i = V_i * Lambda_i for the d x d blocks Lambda (d x dn) and the r x d
-// blocks V_i of V (r x dn).
+// blocks V_i of V (r x dn); large products split by blocks over up to
+// `num_threads` threads (the same results for any count).
 void BlockDiagonalMultiply(const Eigen::MatrixXd& V,
                            const Eigen::MatrixXd& Lambda, int d,
-                           Eigen::MatrixXd* out);
+                           Eigen::MatrixXd* out, int num_threads = 1);
 
 }  // namespace ceres_sesync::internal
 
