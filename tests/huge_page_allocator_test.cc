@@ -16,8 +16,6 @@
 namespace ceres_sesync::internal {
 namespace {
 
-constexpr std::uintptr_t kTwoMiB = std::uintptr_t{2} << 20;
-
 TEST(HugePageAllocator, VectorsKeepTheirContentsAtEverySize) {
   // From below the threshold (standard allocator) through it (growth moves
   // the contents into a mapped block) and back (shrink_to_fit).
@@ -38,6 +36,9 @@ TEST(HugePageAllocator, VectorsKeepTheirContentsAtEverySize) {
             1.5 * static_cast<double>(zeros.size()));
 }
 
+#ifdef CERES_SESYNC_HUGE_PAGES
+constexpr std::uintptr_t kTwoMiB = std::uintptr_t{2} << 20;
+
 // The VmFlags line of the mapping containing `address` in /proc/self/smaps.
 std::string VmFlagsOf(const void* address) {
   std::ifstream smaps("/proc/self/smaps");
@@ -56,6 +57,7 @@ std::string VmFlagsOf(const void* address) {
   }
   return "";
 }
+#endif
 
 TEST(HugePageAllocator, LargeBlocksAreAlignedAndAdvised) {
 #ifndef CERES_SESYNC_HUGE_PAGES
