@@ -239,7 +239,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     }
   };
   if (parallel_window) {
-    preconditioner_pending_ = std::async(std::launch::async, prepare);
+    setup_pending_ = std::async(std::launch::async, prepare);
   } else {
     prepare();
   }
@@ -248,8 +248,8 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   ok_ = true;
 }
 
-void Staircase::AwaitPreconditioner() {
-  if (preconditioner_pending_.valid()) preconditioner_pending_.get();
+void Staircase::AwaitSetup() {
+  if (setup_pending_.valid()) setup_pending_.get();
 }
 
 void Staircase::SetScales() {
@@ -260,7 +260,7 @@ void Staircase::SetScales() {
 }
 
 bool Staircase::Reweight(MeasurementWeights weights, Clock::time_point start) {
-  AwaitPreconditioner();
+  AwaitSetup();
   CHECK(problem_ != nullptr) << "Reweight() needs a valid, non-trivial problem";
   start_ = start;
   const int m = static_cast<int>(graph_.measurements.size());
@@ -374,7 +374,7 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
     }
     Y->topRows(d) = R;
   }
-  AwaitPreconditioner();
+  AwaitSetup();
   s.initialization_time_s =
       std::chrono::duration<double>(Clock::now() - t).count();
   return true;
@@ -558,7 +558,7 @@ ProofPolicy ToPolicy(SolverOptions::ProofArithmetic arithmetic) {
 
 VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
                                      double sdp_value) {
-  AwaitPreconditioner();
+  AwaitSetup();
   const int d = d_, n = n_;
   VerificationOptions verification_options;
   verification_options.eta_target =
@@ -635,7 +635,7 @@ bool Staircase::Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus) {
 }
 
 void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
-  AwaitPreconditioner();
+  AwaitSetup();
   SolverSummary& s = *summary_;
   for (int r = static_cast<int>(Y->rows()), first = r;; ++r) {
     SolverSummary::Level level;
@@ -738,7 +738,7 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
 }
 
 Solution Staircase::Round(const Eigen::MatrixXd& Y) {
-  AwaitPreconditioner();
+  AwaitSetup();
   SolverSummary& s = *summary_;
   Progress("round", static_cast<int>(Y.rows()));
   const auto t = Clock::now();
@@ -798,7 +798,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
 }
 
 void Staircase::Report(const Eigen::MatrixXd& Y, const Solution& solution) {
-  AwaitPreconditioner();
+  AwaitSetup();
   SolverSummary& s = *summary_;
   s.objective =
       problem_->weights().empty()

@@ -124,7 +124,7 @@ class Staircase {
 
   const SESyncProblem& problem() const { return *problem_; }
   SESyncCost& cost() {
-    AwaitPreconditioner();
+    AwaitSetup();
     return *cost_;
   }
   // The last level's verification (after Run()).
@@ -139,10 +139,10 @@ class Staircase {
                 double objective = 0, double gradient_norm = 0) const;
   // scale_ and zero_objective_ from the problem's current data.
   void SetScales();
-  // Waits for the work run concurrently with Initialize() (see the
-  // constructor): the preconditioner and cost, or the double-double
-  // analysis, if it is still running.
-  void AwaitPreconditioner();
+  // Waits for the set-up run concurrently with Initialize() (see the
+  // constructor: certificate_, preconditioner_, cost_ and, with
+  // block-Jacobi, the double-double analysis), if it is still running.
+  void AwaitSetup();
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
   // start + max_time_s, or time_point::max() for no limit.
@@ -184,10 +184,10 @@ class Staircase {
   std::unique_ptr<CertificateMatrix> certificate_;
   std::unique_ptr<SESyncPreconditioner> preconditioner_;
   std::unique_ptr<SESyncCost> cost_;
-  // Builds preconditioner_ and cost_, or the certificate's double-double
-  // analysis, on another thread (declared after what it uses, so that it is
-  // joined before they are destroyed).
-  std::future<void> preconditioner_pending_;
+  // Builds certificate_, preconditioner_ and cost_ (and runs the
+  // double-double analysis) on another thread (declared after what it uses,
+  // so that it is joined before they are destroyed).
+  std::future<void> setup_pending_;
   VerificationResult verification_;
   double sdp_value_ = 0;
   double lower_bound_ = 0;  // Proven at the last verification.
