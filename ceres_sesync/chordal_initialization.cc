@@ -76,10 +76,9 @@ bool ComplexChordalSystem(const SparseMatrix& L,
         block[i][it.row() % 2 + 2 * (c % 2)] = it.value();
       }
     }
-    bool complex_form = true;
     for (int i : touched) {
       const std::array<double, 4>& v = block[i];
-      complex_form = complex_form && v[0] == v[3] && v[2] == -v[1];
+      if (v[0] != v[3] || v[2] != -v[1]) return false;
       const std::complex<double> z(v[0], v[1]);
       const int fr = free_index[i], fc = free_index[j];
       if (fr >= 0 && fc >= 0 && fr >= fc) triplets.emplace_back(fr, fc, z);
@@ -88,7 +87,6 @@ bool ComplexChordalSystem(const SparseMatrix& L,
       seen[i] = 0;
     }
     touched.clear();
-    if (!complex_form) return false;
   }
   Z->resize(num_free, num_free);
   Z->setFromTriplets(triplets.begin(), triplets.end());
@@ -133,7 +131,8 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
     if (free_index[i] < 0) R->middleCols(d * i, d).setIdentity();
   }
   if (num_free == 0) return true;
-  // The fill-reducing ordering of the free blocks, if given for all.
+  // The fill-reducing ordering of the free blocks: empty unless given for
+  // all of them.
   std::vector<int> block_order;
   if (block_ordering != nullptr) {
     std::vector<char> seen(n, 0);
@@ -156,7 +155,7 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
     if (ComplexChordalSystem(L, free_index, num_free, &Z, &b)) {
       ComplexCholmodFactor factor;
       ConfigureCholmod(CholmodLayout::kAutomatic, &factor);
-      if (static_cast<int>(block_order.size()) == num_free) {
+      if (!block_order.empty()) {
         factor.AnalyzePatternWithOrdering(Z, block_order);
       } else {
         factor.analyzePattern(Z);
@@ -206,7 +205,7 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
   for (int k : block_order) {
     for (int a = 0; a < d; ++a) ordering.push_back(d * k + a);
   }
-  if (static_cast<int>(ordering.size()) == d * num_free) {
+  if (!ordering.empty()) {
     factor.AnalyzePatternWithOrdering(L_ff, std::move(ordering));
   } else {  // No ordering, or not of every free block: CHOLMOD's own.
     factor.analyzePattern(L_ff);
