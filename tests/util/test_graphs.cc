@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "Eigen/Dense"
 #include "ceres_sesync/langevin.h"
@@ -195,6 +196,23 @@ double GaugeInvariantPoseDistance(const Poses& a, const Poses& b) {
   return worst;
 }
 
+namespace {
+
+// M += w E E^T, touching only the rows where E is nonzero (E, a residual's
+// selector, has at most a few; the full-size product would cost O(size^2)
+// per term and a size x size temporary). Same sum as the dense product.
+void AddWeightedGram(double w, const Eigen::MatrixXd& E, Eigen::MatrixXd* M) {
+  std::vector<int> rows;
+  for (int r = 0; r < E.rows(); ++r) {
+    if (!E.row(r).isZero(0)) rows.push_back(r);
+  }
+  for (int a : rows) {
+    for (int b : rows) (*M)(a, b) += w * E.row(a).dot(E.row(b));
+  }
+}
+
+}  // namespace
+
 Eigen::MatrixXd DenseDataMatrix(const PoseGraph& graph) {
   const int d = graph.dimension, n = graph.num_poses;
   const int size = n + d * n;
@@ -205,13 +223,13 @@ Eigen::MatrixXd DenseDataMatrix(const PoseGraph& graph) {
     Eigen::MatrixXd E = Eigen::MatrixXd::Zero(size, d);
     E.middleRows(n + d * m.j, d) += Eigen::MatrixXd::Identity(d, d);
     E.middleRows(n + d * m.i, d) -= m.R;
-    M += m.kappa * E * E.transpose();
+    AddWeightedGram(m.kappa, E, &M);
     // X e = t_j - t_i - R_i t~.
     Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
     e(m.j) += 1;
     e(m.i) -= 1;
     e.segment(n + d * m.i, d) -= m.t;
-    M += m.tau * e * e.transpose();
+    AddWeightedGram(m.tau, e, &M);
   }
   return M;
 }
@@ -227,33 +245,33 @@ Eigen::MatrixXd DenseLandmarkDataMatrix(const PoseGraph& graph) {
     Eigen::MatrixXd E = Eigen::MatrixXd::Zero(size, d);
     E.middleRows(rot(m.j), d) += I;
     E.middleRows(rot(m.i), d) -= m.R;
-    M += m.kappa * E * E.transpose();
+    AddWeightedGram(m.kappa, E, &M);
     Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
     e(m.j) += 1;
     e(m.i) -= 1;
     e.segment(rot(m.i), d) -= m.t;
-    M += m.tau * e * e.transpose();
+    AddWeightedGram(m.tau, e, &M);
   }
   for (const LandmarkMeasurement& m : graph.landmark_measurements) {
     Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
     e(n + m.l) += 1;
     e(m.i) -= 1;
     e.segment(rot(m.i), d) -= m.z;
-    M += m.nu * e * e.transpose();
+    AddWeightedGram(m.nu, e, &M);
   }
   for (const PosePrior& p : graph.priors) {
     if (p.kappa > 0) {
       Eigen::MatrixXd E = Eigen::MatrixXd::Zero(size, d);
       E.middleRows(rot(p.i), d) += I;
       E.middleRows(rot(n), d) -= p.R;
-      M += p.kappa * E * E.transpose();
+      AddWeightedGram(p.kappa, E, &M);
     }
     if (p.tau > 0) {
       Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
       e(p.i) += 1;
       e(tw) -= 1;
       e.segment(rot(n), d) -= p.t;
-      M += p.tau * e * e.transpose();
+      AddWeightedGram(p.tau, e, &M);
     }
   }
   return M;
