@@ -175,24 +175,30 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
           -(Inner(g, step.eta) + 0.5 * Inner(step.eta, step.h_eta));
       cost->Retract(*x, step.eta, &x_new);
       const double f_new = cost->Evaluate(x_new);
-      const double actual_decrease = f - f_new;
+      double actual_decrease = f - f_new;
+      // Decreases must stand above the round-off in f (or in the cost's own
+      // difference, when it has one).
+      double noise = 4 * std::numeric_limits<double>::epsilon() * std::abs(f);
       // rho with a small safeguard against round-off when both are tiny.
-      const double eps = 1e-14 * std::max(1.0, std::abs(f));
+      double eps = 1e-14 * std::max(1.0, std::abs(f));
+      double difference, round_off;
+      if (std::isfinite(f_new) &&
+          cost->EvaluationDifference(&difference, &round_off)) {
+        actual_decrease = -difference;
+        noise = eps = round_off;
+      }
       const double rho =
           (actual_decrease + eps) / (std::max(model_decrease, 0.0) + eps);
       const double step_norm = std::sqrt(Inner(step.eta, step.eta));
-      // Accept only finite decreases that stand above the round-off in f.
-      const double noise =
-          4 * std::numeric_limits<double>::epsilon() * std::abs(f);
       const bool accepted =
-          rho > 0.1 && std::isfinite(f_new) && f - f_new > noise;
+          rho > 0.1 && std::isfinite(f_new) && actual_decrease > noise;
       if (!accepted || !(rho >= 0.25)) {
         radius *= 0.25;  // Every rejection shrinks the region (also NaN rho).
       } else if (rho > 0.75 && step.hit_boundary) {
         radius *= 2;
       }
       if (accepted) {
-        const double decrease = f - f_new;
+        const double decrease = actual_decrease;
         *x = x_new;
         f = f_new;
         summary->iterations = k + 1;

@@ -32,6 +32,18 @@ class RiemannianCostFunction {
   virtual void Precondition(const Eigen::MatrixXd& v, Eigen::MatrixXd* pv) {
     *pv = v;
   }
+  // Optional: f(x') - f(x) for the point evaluated last (x') and the one
+  // evaluated just before it (x), computed without subtracting the two
+  // values, and a bound on its round-off. Near a minimum where f is a sum of
+  // large terms that nearly cancel (a zero-residual fit), the round-off of
+  // f itself (~eps times the terms) swamps the decrease of a step and stops
+  // the solve short; a difference computed from x' - x does not. Returns
+  // false (the default) to use the two values.
+  virtual bool EvaluationDifference(double* difference, double* round_off) {
+    (void)difference;
+    (void)round_off;
+    return false;
+  }
   // Retraction: the point reached from x along the tangent vector v.
   virtual void Retract(const Eigen::MatrixXd& x, const Eigen::MatrixXd& v,
                        Eigen::MatrixXd* result) = 0;

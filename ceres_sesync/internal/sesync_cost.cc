@@ -1,6 +1,7 @@
 #include "ceres_sesync/internal/sesync_cost.h"
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -150,10 +151,26 @@ SESyncCost::SESyncCost(const SESyncProblem* problem,
       d_(problem->dimension()) {}
 
 double SESyncCost::Evaluate(const Eigen::MatrixXd& Y) {
+  // The buffers swap: no allocation once their shapes are set.
+  Y_.swap(previous_Y_);
+  YQ_.swap(previous_YQ_);
   Y_ = Y;
   problem_->MultiplyQ(Y_, &YQ_);
   lambda_ = SymBlockDiagProduct(YQ_, Y_, d_);
   return Y_.cwiseProduct(YQ_).sum();
+}
+
+bool SESyncCost::EvaluationDifference(double* difference, double* round_off) {
+  if (previous_Y_.rows() != Y_.rows() || previous_Y_.cols() != Y_.cols() ||
+      previous_YQ_.size() != YQ_.size()) {
+    return false;
+  }
+  const auto step = Y_ - previous_Y_;
+  const auto sum = YQ_ + previous_YQ_;
+  *difference = step.cwiseProduct(sum).sum();
+  *round_off = 4 * std::numeric_limits<double>::epsilon() *
+               step.cwiseAbs().cwiseProduct(sum.cwiseAbs()).sum();
+  return true;
 }
 
 void SESyncCost::Gradient(Eigen::MatrixXd* gradient) {

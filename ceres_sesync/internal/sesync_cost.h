@@ -133,6 +133,11 @@ class SESyncCost : public RiemannianCostFunction {
                         Eigen::MatrixXd* result) override;
   // SESyncPreconditioner::Update (kAdaptive).
   bool UpdatePreconditioner(int inner_iterations, bool converged) override;
+  // F(Y') - F(Y) = <Y' - Y, (Y' + Y) Q> (Q symmetric) for the last two
+  // evaluated points of the same shape, from their cached products with Q;
+  // round-off 4 eps sum |Y' - Y| |(Y' + Y) Q| (elementwise; the products'
+  // own round-off is of the same order).
+  bool EvaluationDifference(double* difference, double* round_off) override;
 
   // Lagrange multipliers Lambda = SymBlockDiag_d(Q Y^T Y) (d x dn) at the
   // current point.
@@ -144,6 +149,8 @@ class SESyncCost : public RiemannianCostFunction {
   SESyncPreconditioner* preconditioner_;
   int d_;
   Eigen::MatrixXd Y_, YQ_, lambda_;
+  // The point evaluated before the current one, and its product with Q.
+  Eigen::MatrixXd previous_Y_, previous_YQ_;
   Eigen::MatrixXd vq_, v_lambda_;  // Workspace of HessianVector/Precondition.
   int hessian_vector_products_ = 0;
 };
