@@ -41,6 +41,10 @@ TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
       r0 * std::min(std::pow(r0 / reference_norm, options.tcg_theta),
                     options.tcg_kappa);
   const double radius2 = radius * radius;
+  // sqrt(<r, P r>) <= the fraction of the outer tolerance, squared.
+  const double floor = options.tcg_tolerance_fraction *
+                       options.preconditioned_gradient_tolerance;
+  const double floor2 = floor > 0 ? floor * floor : -1;
   for (int j = 0; j < options.max_inner_iterations; ++j) {
     cost->HessianVector(delta, &h_delta);
     ++out.iterations;
@@ -70,6 +74,7 @@ TcgResult TruncatedCg(const RiemannianTrustRegionOptions& options,
     cost->Precondition(r, &z);
     const double z_r_old = z_r;
     z_r = Inner(z, r);
+    if (z_r <= floor2) return out;
     const double beta = z_r / z_r_old;
     delta = beta * delta - z;
     e_pd = beta * (e_pd + alpha * d_pd);
