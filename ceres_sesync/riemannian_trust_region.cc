@@ -203,7 +203,6 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
         radius *= 2;
       }
       if (accepted) {
-        const double decrease = actual_decrease;
         *x = x_new;
         f = f_new;
         summary->iterations = k + 1;
@@ -213,20 +212,20 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
           summary->final_gradient_norm = std::sqrt(Inner(g, g));
           return finish(Termination::kUserCallback);
         }
+        const bool small_decrease =
+            actual_decrease <=
+            options.relative_decrease_tolerance * std::abs(f);
         // A convergence test met under a preconditioner that then changes
         // goes on in the new one (see UpdatePreconditioner).
-        if ((decrease <= options.relative_decrease_tolerance * std::abs(f) ||
-             step_norm <= options.step_tolerance) &&
+        if ((small_decrease || step_norm <= options.step_tolerance) &&
             !(switched = cost->UpdatePreconditioner(0, /*converged=*/true))) {
           cost->Gradient(&g);
           cost->Precondition(g, &pg);
           summary->final_gradient_norm = std::sqrt(Inner(g, g));
           summary->final_preconditioned_gradient_norm =
               std::sqrt(std::max(0.0, Inner(g, pg)));
-          return finish(decrease <= options.relative_decrease_tolerance *
-                                        std::abs(f)
-                            ? Termination::kRelativeDecrease
-                            : Termination::kStepTolerance);
+          return finish(small_decrease ? Termination::kRelativeDecrease
+                                       : Termination::kStepTolerance);
         }
         break;
       }

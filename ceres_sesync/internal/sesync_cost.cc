@@ -161,8 +161,8 @@ double SESyncCost::Evaluate(const Eigen::MatrixXd& Y) {
 }
 
 bool SESyncCost::EvaluationDifference(double* difference, double* round_off) {
-  if (previous_Y_.rows() != Y_.rows() || previous_Y_.cols() != Y_.cols() ||
-      previous_YQ_.size() != YQ_.size()) {
+  // previous_YQ_ has previous_Y_'s shape (empty before a second Evaluate).
+  if (previous_Y_.rows() != Y_.rows() || previous_Y_.cols() != Y_.cols()) {
     return false;
   }
   const auto step = Y_ - previous_Y_;
