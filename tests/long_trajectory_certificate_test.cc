@@ -329,6 +329,56 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   EXPECT_EQ(reference.NegativePivots(raised, s.eta), 0)
       << "FALSE CERTIFICATE at eta " << s.eta;
   EXPECT_LT(s.eta, 16 * saddle.eta_max);  // Tightened below the witness's.
+
+  // A deeper saddle, lambda_min(S') = -40 eta_max (a 10^6-pose city:
+  // -26 eta_max): the ladder's first shift fails, its second (256 eta_max)
+  // proves, still before the poor-candidate test: 16 and 256 eta_max, then
+  // the tightening, three factorizations (four with that test first).
+  // Its tolerance half of double's floor (large maps' is below the floor
+  // too), so that 16 eta_max is above the floor and 256 eta_max below
+  // tr(Lambda') / dn, where the poor-candidate test factorizes.
+  internal::CertificateMatrix deep_matrix(problem);
+  internal::VerificationOptions deeper = hinted;
+  deeper.eta_max =
+      std::max(options.eta_max, 0.5 * deep_matrix.next_double_shift() * spread);
+  const double deep_delta = 40 * deeper.eta_max + true_shift;
+  const Eigen::MatrixXd deep = raise(deep_delta);
+  ASSERT_LT(256 * deeper.eta_max,
+            internal::BlockDiagonalTrace(deep, c.d) / deep.cols());
+  const internal::VerificationResult t =
+      internal::VerifyCertificate(problem, deep, deeper, &deep_matrix);
+  EXPECT_FALSE(t.certified);
+  EXPECT_FALSE(t.vacuous_bound);
+  EXPECT_EQ(t.extended_factorizations, 1);
+  EXPECT_EQ(t.factorizations, 3);
+  ASSERT_TRUE(std::isfinite(t.eta));
+  EXPECT_EQ(reference.NegativePivots(deep, t.eta), 0)
+      << "FALSE CERTIFICATE at eta " << t.eta;
+  EXPECT_LT(t.eta, 256 * deeper.eta_max);
+  // lambda_min(S') = lambda_min(S) - deep_delta, to ReferenceShift's 1e-3.
+  const double deep_lambda_min = -(true_shift + deep_delta);
+  EXPECT_LE(t.direction_curvature, 0.99 * deep_lambda_min);
+  EXPECT_GE(t.direction_curvature, 1.001 * deep_lambda_min);
+
+  // As the staircase calls it below its top rank (tighten_uncertified
+  // false): the witness alone, from a looser Lanczos tolerance, two
+  // factorizations; its curvature (a Rayleigh quotient, >= lambda_min) is
+  // still within 5% of lambda_min(S') (measured: 0.2% with the tight
+  // tolerance, 2.5% with the loose one, on the 2D corridor).
+  internal::VerificationOptions escape = deeper;
+  escape.tighten_uncertified = false;
+  internal::CertificateMatrix escape_matrix(problem);
+  const internal::VerificationResult e =
+      internal::VerifyCertificate(problem, deep, escape, &escape_matrix);
+  EXPECT_FALSE(e.certified);
+  EXPECT_EQ(e.factorizations, 2);
+  EXPECT_EQ(e.extended_factorizations, 1);
+  EXPECT_EQ(e.direction.size(), c.d * c.n);
+  EXPECT_LE(e.direction_curvature, 0.95 * deep_lambda_min);
+  EXPECT_GE(e.direction_curvature, 1.001 * deep_lambda_min);
+  ASSERT_TRUE(std::isfinite(e.eta));
+  EXPECT_EQ(reference.NegativePivots(deep, e.eta), 0)
+      << "FALSE CERTIFICATE at eta " << e.eta;
 }
 
 INSTANTIATE_TEST_SUITE_P(Corridors, LongTrajectoryCertificate,
