@@ -662,5 +662,50 @@ TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
   EXPECT_GT(s_last.lower_bound, 0);
 }
 
+// The same city's rank-4 saddle is a lifted rank-2 critical point (Y of
+// numerical rank 2), so its rounding is a critical point of the rank-2
+// problem, below the rounding of the rank-5 point. Round() refines from it:
+// (almost) no products, and the poses are a local optimum within the
+// tolerance of the proven bound, at the saddle's objective.
+TEST(SESyncSolver, RoundingStartsFromTheEscapedSaddlesRounding) {
+  CityOptions city;
+  city.num_poses = 1000;
+  city.kappa = 10;
+  city.seed = 1;
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(GenerateCity(city, &graph, nullptr, &error)) << error;
+  SolverOptions options;
+  options.num_threads = 1;
+  SolverSummary s;
+  const Poses x = Solve(graph, options, &s);
+  ASSERT_EQ(s.status, Status::kCertifiedOptimum) << s.FullReport();
+  ASSERT_EQ(s.levels.size(), 2u) << "the fixture must escape a saddle";
+  int level_products = 0;
+  for (const SolverSummary::Level& level : s.levels) {
+    level_products += level.hessian_vector_products;
+  }
+  const int refinement_products = s.hessian_vector_products - level_products;
+  std::printf("refinement products %d, F(x) %.12g, saddle F(Y) %.12g\n",
+              refinement_products, s.objective, s.levels[0].sdp_value);
+  EXPECT_LE(refinement_products, 2);
+  // At the saddle's objective (its rounding loses nothing), above the
+  // rank-5 value, within the tolerance of the bound.
+  EXPECT_NEAR(s.objective, s.levels[0].sdp_value, 1e-9 * s.levels[0].sdp_value);
+  EXPECT_GT(s.objective, s.sdp_value);
+  EXPECT_LE(s.relative_suboptimality_bound,
+            options.certification_max_relative_bound);
+  // A local optimum: no pose's rotation moves to lower the objective (the
+  // objective at small rotations of single poses, both signs).
+  const double f = EvaluateObjective(graph, x);
+  for (int i : {1, 250, 500, 999}) {
+    for (double angle : {-1e-4, 1e-4}) {
+      Poses turned = x;
+      turned[i].R = turned[i].R * Eigen::Rotation2Dd(angle).toRotationMatrix();
+      EXPECT_GE(EvaluateObjective(graph, turned), f - 1e-9 * f) << i;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ceres_sesync

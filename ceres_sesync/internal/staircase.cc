@@ -637,6 +637,8 @@ bool Staircase::Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus) {
 void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
   AwaitSetup();
   SolverSummary& s = *summary_;
+  escaped_rounding_.resize(0, 0);
+  escaped_rounding_value_ = std::numeric_limits<double>::infinity();
   for (int r = static_cast<int>(Y->rows()), first = r;; ++r) {
     SolverSummary::Level level;
     level.rank = r;
@@ -727,6 +729,7 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
       s.status = SolverSummary::Status::kMaxRankReached;
       return;
     }
+    KeepRounding(*Y);
     Eigen::MatrixXd Y_plus;
     if (!Escape(*Y, &Y_plus)) {
       s.status = SolverSummary::Status::kSaddleNotEscaped;
@@ -737,6 +740,17 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
   }
 }
 
+void Staircase::KeepRounding(const Eigen::MatrixXd& Y) {
+  Eigen::MatrixXd R = RoundSolution(Y, d_);
+  Eigen::MatrixXd RQ;
+  problem_->MultiplyQ(R, &RQ);
+  const double value = R.cwiseProduct(RQ).sum();
+  if (value < escaped_rounding_value_) {
+    escaped_rounding_ = std::move(R);
+    escaped_rounding_value_ = value;
+  }
+}
+
 Solution Staircase::Round(const Eigen::MatrixXd& Y) {
   AwaitSetup();
   SolverSummary& s = *summary_;
@@ -744,20 +758,51 @@ Solution Staircase::Round(const Eigen::MatrixXd& Y) {
   const auto t = Clock::now();
   Eigen::MatrixXd R = RoundSolution(Y, d_);
   if (options_.refine_rounded_solution) {
-    // Local search on O(d)^n = St(d, d)^n from the rounded rotations (blocks
-    // stay in SO(d) by continuity). A no-op when the relaxation is exact.
-    const double rounded = cost_->Evaluate(R);
-    if (rounded > sdp_value_ * (1 + 1e-12)) {
+    // Local search on O(d)^n = St(d, d)^n from rounded rotations X with
+    // objective `rounded` (blocks stay in SO(d) by continuity); returns the
+    // objective at the result. A no-op when the relaxation is exact.
+    auto refine = [&](double rounded, Eigen::MatrixXd* X) {
+      if (!(rounded > sdp_value_ * (1 + 1e-12))) return rounded;
       RiemannianTrustRegionOptions rtr = TrustRegionOptions(options_);
       rtr.max_time_s = RemainingTime();
       rtr.preconditioned_gradient_tolerance =
           options_.relative_preconditioned_gradient_tolerance *
           std::sqrt(rounded);
       RiemannianTrustRegionSummary refine_summary;
-      MinimizeRiemannianTrustRegion(rtr, cost_.get(), &R, &refine_summary);
+      MinimizeRiemannianTrustRegion(rtr, cost_.get(), X, &refine_summary);
       s.iterations += refine_summary.iterations;
       s.hessian_vector_products += refine_summary.hessian_vector_products;
-      R = ProjectBlocksToRotations(R, d_);
+      *X = ProjectBlocksToRotations(*X, d_);
+      return refine_summary.final_cost;
+    };
+    const double rounded = cost_->Evaluate(R);
+    // A level escaped from rounds lower (escaped_rounding_). Certified: refine
+    // from there, and keep the result if it is within the tolerance of the
+    // proven bound (with 1% of it to spare for F's evaluation in Report());
+    // else refine Y's rounding too and keep the lower objective, so that no
+    // certificate is lost. Out of time: the lower rounding is the better
+    // answer (the refinement has no time left). Otherwise (no bound) Y's
+    // rounding as always.
+    const bool time_limit = s.status == SolverSummary::Status::kTimeLimit;
+    if (escaped_rounding_value_ < rounded &&
+        (verification_.certified || time_limit)) {
+      Eigen::MatrixXd from_escape = escaped_rounding_;
+      const double value = refine(escaped_rounding_value_, &from_escape);
+      const double tolerance = options_.certification_max_relative_bound;
+      const bool within =
+          verification_.certified && lower_bound_ > 0 &&
+          value - lower_bound_ <= 0.99 * tolerance * lower_bound_;
+      if (within || time_limit || value < refine(rounded, &R)) {
+        R = std::move(from_escape);
+      }
+      if (options_.verbose) {
+        LOG(INFO) << "rounding: an escaped level's rounding, F "
+                  << escaped_rounding_value_ << " (Y's " << rounded
+                  << "), refined to " << value
+                  << (within ? ", within the tolerance" : "");
+      }
+    } else {
+      refine(rounded, &R);
     }
   }
   const Eigen::MatrixXd T = problem_->RecoverTranslations(R);

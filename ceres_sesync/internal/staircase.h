@@ -39,6 +39,7 @@
 
 #include <chrono>
 #include <future>
+#include <limits>
 #include <memory>
 
 #include "Eigen/Core"
@@ -112,7 +113,11 @@ class Staircase {
 
   // Stage "round": Algorithm 2 on Y, the optional refinement on SO(d)^n, the
   // optimal translations and landmark positions (eq. 21), in the documented
-  // gauge (ToSolutionInGauge).
+  // gauge (ToSolutionInGauge). When the last level is certified (or the time
+  // limit stopped Run()) and a level escaped from rounds to a lower
+  // objective (escaped_rounding_), the refinement starts from that rounding
+  // instead; if the result is then not within the tolerance of the proven
+  // bound, Y's rounding is refined as well and the lower of the two kept.
   Solution Round(const Eigen::MatrixXd& Y);
 
   // Stage "report": objective, lower bound, suboptimality bounds, rounding
@@ -167,6 +172,8 @@ class Staircase {
                        SolverSummary::Level* level);
   // The deferred double-double proof (see Report()).
   void TightenProof(const Eigen::MatrixXd& Y, double objective);
+  // Keeps the rounding of Y if its objective is below escaped_rounding_'s.
+  void KeepRounding(const Eigen::MatrixXd& Y);
   // Escapes the saddle at rank r along the verification's direction; false
   // if no descent was found.
   bool Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus);
@@ -189,6 +196,14 @@ class Staircase {
   // so that it is joined before they are destroyed).
   std::future<void> setup_pending_;
   VerificationResult verification_;
+  // The lowest-objective rounding of the levels Run() escaped from, and its
+  // objective (+infinity: none). At a lifted saddle (Y of numerical rank d)
+  // it is a critical point of the rank-d problem, and often the final
+  // answer: on a 10^6-pose city the rank-5 descent after the rank-4 saddle
+  // only raised the lower bound, and its rounding refined back to the same
+  // poses (33 s of refinement).
+  Eigen::MatrixXd escaped_rounding_;
+  double escaped_rounding_value_ = std::numeric_limits<double>::infinity();
   double sdp_value_ = 0;
   double lower_bound_ = 0;  // Proven at the last verification.
   // The last verification skipped double-double (not exact: see Verify()).
