@@ -580,20 +580,26 @@ TEST(SESyncSolver, AutomaticPreconditionerSwitchesWhenBlockJacobiIsSlow) {
   EXPECT_GT(std::stoi(s.preconditioner.substr(prefix.size())), 20 * 7);
 }
 
-// A 1000-pose city at kappa 10 (seed 1) has a rank-4 saddle: the staircase
-// escapes to rank 5, where the relaxation is not exact (its bound is about
-// the rounding gap, 2.3e-4). Certificate tests during the rank-5 descent
-// (SolverOptions::test_certificate_after_escape) stop it once one passes;
-// the run is the one without tests, stopped earlier, so the poses are the
-// same and both lower bounds hold for both objectives.
-TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
+// A 1000-pose city at kappa 10 (seed 1), which has a rank-4 saddle.
+PoseGraph CityWithSaddle() {
   CityOptions city;
   city.num_poses = 1000;
   city.kappa = 10;
   city.seed = 1;
   PoseGraph graph;
   std::string error;
-  ASSERT_TRUE(GenerateCity(city, &graph, nullptr, &error)) << error;
+  EXPECT_TRUE(GenerateCity(city, &graph, nullptr, &error)) << error;
+  return graph;
+}
+
+// The city's rank-4 saddle: the staircase escapes to rank 5, where the
+// relaxation is not exact (its bound is about the rounding gap, 2.3e-4).
+// Certificate tests during the rank-5 descent
+// (SolverOptions::test_certificate_after_escape) stop it once one passes;
+// the run is the one without tests, stopped earlier, so the poses are the
+// same and both lower bounds hold for both objectives.
+TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
+  const PoseGraph graph = CityWithSaddle();
   SolverOptions on;
   on.num_threads = 1;
   SolverOptions off = on;
@@ -668,13 +674,7 @@ TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
 // (almost) no products, and the poses are a local optimum within the
 // tolerance of the proven bound, at the saddle's objective.
 TEST(SESyncSolver, RoundingStartsFromTheEscapedSaddlesRounding) {
-  CityOptions city;
-  city.num_poses = 1000;
-  city.kappa = 10;
-  city.seed = 1;
-  PoseGraph graph;
-  std::string error;
-  ASSERT_TRUE(GenerateCity(city, &graph, nullptr, &error)) << error;
+  const PoseGraph graph = CityWithSaddle();
   SolverOptions options;
   options.num_threads = 1;
   SolverSummary s;
