@@ -16,6 +16,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "Eigen/Dense"
@@ -705,6 +706,40 @@ TEST(SESyncSolver, RoundingStartsFromTheEscapedSaddlesRounding) {
       EXPECT_GE(EvaluateObjective(graph, turned), f - 1e-9 * f) << i;
     }
   }
+}
+
+// Out of time in the descent after the saddle: the answer is the saddle's
+// rounding (a critical point of the rank-2 problem), not the unfinished
+// rank-5 point's, which the refinement has no time left for. The limit is
+// set well past the time the reference run needed to reach rank 5, and the
+// callback sleeps through it at rank 5's first iteration.
+TEST(SESyncSolver, TimeLimitAfterAnEscapeReturnsTheSaddlesRounding) {
+  const PoseGraph graph = CityWithSaddle();
+  SolverOptions options;
+  options.num_threads = 1;
+  SolverSummary reference;
+  Solve(graph, options, &reference);
+  ASSERT_EQ(reference.levels.size(), 2u) << reference.FullReport();
+  const double to_rank_5 =
+      reference.data_time_s + reference.initialization_time_s +
+      reference.levels[0].optimize_time_s + reference.levels[0].verify_time_s;
+  options.max_time_s = 5 * to_rank_5 + 0.5;
+  const auto start = std::chrono::steady_clock::now();
+  options.callback = [&](int rank, int, double, double, double) {
+    if (rank == 5) {
+      std::this_thread::sleep_until(
+          start + std::chrono::duration<double>(options.max_time_s + 0.2));
+    }
+    return true;
+  };
+  SolverSummary s;
+  const Poses x = Solve(graph, options, &s);
+  EXPECT_EQ(s.status, Status::kTimeLimit) << s.FullReport();
+  ASSERT_EQ(s.levels.size(), 2u) << s.FullReport();
+  const double saddle = s.levels[0].sdp_value;
+  EXPECT_NEAR(s.objective, saddle, 1e-9 * saddle) << s.FullReport();
+  EXPECT_NEAR(EvaluateObjective(graph, x), reference.objective,
+              1e-9 * reference.objective);
 }
 
 }  // namespace
