@@ -588,12 +588,15 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
   // would mostly be wasted: it is deferred to Report(), which runs it only
   // if the tolerance needs it.
   extended_deferred_ = false;
-  const Eigen::MatrixXd R = RoundSolution(Y, d);
+  verified_rounding_ = RoundSolution(Y, d);
+  verified_rounding_value_ = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::MatrixXd& R = verified_rounding_;
   if (verification_options.policy == ProofPolicy::kAutomatic && Y.rows() > d &&
       sdp_value > 0) {
     Eigen::MatrixXd RQ;
     problem_->MultiplyQ(R, &RQ);
-    const double gap = (R.cwiseProduct(RQ).sum() - sdp_value) / sdp_value;
+    verified_rounding_value_ = R.cwiseProduct(RQ).sum();
+    const double gap = (verified_rounding_value_ - sdp_value) / sdp_value;
     if (gap > options_.certification_goal_relative_bound) {
       verification_options.policy = ProofPolicy::kDouble;
       extended_deferred_ = true;
@@ -729,7 +732,7 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
       s.status = SolverSummary::Status::kMaxRankReached;
       return;
     }
-    KeepRounding(*Y);
+    KeepRounding();
     Eigen::MatrixXd Y_plus;
     if (!Escape(*Y, &Y_plus)) {
       s.status = SolverSummary::Status::kSaddleNotEscaped;
@@ -740,14 +743,15 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
   }
 }
 
-void Staircase::KeepRounding(const Eigen::MatrixXd& Y) {
-  Eigen::MatrixXd R = RoundSolution(Y, d_);
-  Eigen::MatrixXd RQ;
-  problem_->MultiplyQ(R, &RQ);
-  const double value = R.cwiseProduct(RQ).sum();
-  if (value < escaped_rounding_value_) {
-    escaped_rounding_ = std::move(R);
-    escaped_rounding_value_ = value;
+void Staircase::KeepRounding() {
+  if (std::isnan(verified_rounding_value_)) {
+    Eigen::MatrixXd RQ;
+    problem_->MultiplyQ(verified_rounding_, &RQ);
+    verified_rounding_value_ = verified_rounding_.cwiseProduct(RQ).sum();
+  }
+  if (verified_rounding_value_ < escaped_rounding_value_) {
+    escaped_rounding_ = std::move(verified_rounding_);  // Verify() refills it.
+    escaped_rounding_value_ = verified_rounding_value_;
   }
 }
 

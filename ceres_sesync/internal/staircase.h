@@ -172,8 +172,9 @@ class Staircase {
                        SolverSummary::Level* level);
   // The deferred double-double proof (see Report()).
   void TightenProof(const Eigen::MatrixXd& Y, double objective);
-  // Keeps the rounding of Y if its objective is below escaped_rounding_'s.
-  void KeepRounding(const Eigen::MatrixXd& Y);
+  // Keeps the last verified level's rounding (verified_rounding_) as
+  // escaped_rounding_ if its objective is the lower.
+  void KeepRounding();
   // Escapes the saddle at rank r along the verification's direction; false
   // if no descent was found.
   bool Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus);
@@ -203,6 +204,10 @@ class Staircase {
   // only raised the lower bound, and its rounding refined back to the same
   // poses (33 s of refinement).
   Eigen::MatrixXd escaped_rounding_;
+  // Verify()'s rounding of its Y and that rounding's objective (NaN when
+  // Verify() did not need it).
+  Eigen::MatrixXd verified_rounding_;
+  double verified_rounding_value_ = 0;
   double escaped_rounding_value_ = std::numeric_limits<double>::infinity();
   double sdp_value_ = 0;
   double lower_bound_ = 0;  // Proven at the last verification.
