@@ -379,6 +379,35 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   ASSERT_TRUE(std::isfinite(e.eta));
   EXPECT_EQ(reference.NegativePivots(deep, e.eta), 0)
       << "FALSE CERTIFICATE at eta " << e.eta;
+
+  // The tightening of a shift proven already (a certificate test during
+  // the descent after an escape passed: known_shift), in double as the
+  // staircase runs it when the relaxation is not exact. lambda_min(S') =
+  // -2 double floors: a factor at the known shift, the Lanczos estimate,
+  // and one proof at the first shift of the ladder, which must allow for
+  // what the proofs' translation shift costs (about one floor): two
+  // factorizations, and a shift within 2x of -lambda_min. Starting 10%
+  // above the estimate (2.2 floors) failed there, and the ladder's next
+  // shift, 8x higher, was the result (three factorizations).
+  internal::CertificateMatrix known_matrix(problem);
+  const double floor = known_matrix.next_double_shift() * spread;
+  const double known_delta = 2 * floor + true_shift;
+  const Eigen::MatrixXd near = raise(known_delta);
+  internal::VerificationOptions known = hinted;
+  known.policy = internal::ProofPolicy::kDouble;
+  known.likely_optimal = false;
+  known.eta_max = 128 * floor;
+  known.known_shift = 64 * floor;
+  ASSERT_EQ(reference.NegativePivots(near, known.known_shift), 0);
+  const internal::VerificationResult k =
+      internal::VerifyCertificate(problem, near, known, &known_matrix);
+  EXPECT_TRUE(k.certified);
+  EXPECT_EQ(k.factorizations, 2);
+  EXPECT_EQ(k.extended_factorizations, 0);
+  EXPECT_NEAR(k.lambda_min_estimate, -known_delta, 1e-3 * known_delta);
+  EXPECT_LT(k.eta, 2 * known_delta);
+  EXPECT_EQ(reference.NegativePivots(near, k.eta), 0)
+      << "FALSE CERTIFICATE at eta " << k.eta;
 }
 
 INSTANTIATE_TEST_SUITE_P(Corridors, LongTrajectoryCertificate,
