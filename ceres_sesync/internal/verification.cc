@@ -275,7 +275,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // lambda_min(S) minus it), so 10% alone failed whenever |lambda_min(S)|
   // was within 10x of the floor (a 10^5-pose city's rank-5 certificate:
   // lambda_min -2.4e-5, floor 1.1e-5: 2.66e-5 failed, 2.1e-4 proven; now
-  // 3.7e-5 at the first attempt).
+  // 4.0e-5 at the first attempt).
   auto double_start = [&](double lambda_min) {
     return std::max(
         eta_target,
