@@ -383,21 +383,25 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   double factor_shift = 0;  // The smallest shift proven here.
   bool proven = false;
   bool factor_is_current = false;  // The double factor is that at factor_shift.
-  // The ladder's first two shifts before the poor-candidate test: a saddle's
-  // negative curvature is usually mild (2D cities, kappa 100 at 10^5 poses:
-  // lambda_min(S) = -3 eta_max; kappa 30 at 10^5: -17 eta_max; kappa 100 at
-  // 10^6: -26 eta_max), so one of these proofs is the one the ladder ends
-  // at, and the test's factorization is saved; a poor candidate pays up to
-  // two failed factorizations more.
-  for (int rung = 0; suspect_saddle && !proven && rung < 2 &&
-                     16 * c < std::min(c_vacuous, c_upper);
-       ++rung) {
-    if (prove(16 * c, ProofPrecision::kDouble)) {
+  // The ladder's first two shifts before the poor-candidate test, 64 and
+  // 256 eta_max: a saddle's negative curvature is usually mild (2D cities,
+  // kappa 100 at 10^5 poses: lambda_min(S) = -3 eta_max; kappa 30 at 10^5:
+  // -16 to -19 eta_max; kappa 100 at 10^6: -26 eta_max), so one of these
+  // proofs is the one the ladder ends at, and the test's factorization is
+  // saved; a poor candidate pays up to two failed factorizations more. The
+  // first at 64 rather than 16 eta_max: the measured saddles below -16
+  // eta_max then take one proof instead of a failed one and one at 256
+  // (10^6: ~40 s each); those above take one either way. (16 eta_max
+  // when 64 eta_max is at or above the vacuous shift.)
+  const double c0 = c, limit = std::min(c_vacuous, c_upper);
+  for (const double m : {64 * c0 < limit ? 64.0 : 16.0, 256.0}) {
+    if (!suspect_saddle || proven || !(m * c0 < limit)) break;
+    c = m * c0;  // If it fails, the ladder goes on above it.
+    if (prove(c, ProofPrecision::kDouble)) {
       proven = factor_is_current = true;
-      factor_shift = 16 * c;
+      factor_shift = c;
     }
     if (result.out_of_time) return finish();
-    c *= 16;  // If it failed, the ladder goes on above it.
   }
   if (!proven && c_vacuous > c && c_vacuous < c_upper) {
     if (prove(c_vacuous, ProofPrecision::kDouble)) {

@@ -47,7 +47,7 @@ struct VerificationOptions {
   // double-double factorization more (1.6-1.7x a double one, measured). When
   // that proof fails, the candidate is taken for a lifted saddle: the
   // near-optimality test is skipped, and the witness's ladder proves its
-  // first shift (16 eta_max) before the poor-candidate test (two
+  // first shift (64 eta_max) before the poor-candidate test (two
   // factorizations fewer for a saddle; one more for a poor candidate).
   bool likely_optimal = false;
   // When not certified: prove a last shift just above the Lanczos estimate
