@@ -207,7 +207,7 @@ class Staircase {
   // Verify()'s rounding of its Y and that rounding's objective (NaN when
   // Verify() did not need it).
   Eigen::MatrixXd verified_rounding_;
-  double verified_rounding_value_ = 0;
+  double verified_rounding_value_ = std::numeric_limits<double>::quiet_NaN();
   double escaped_rounding_value_ = std::numeric_limits<double>::infinity();
   double sdp_value_ = 0;
   double lower_bound_ = 0;  // Proven at the last verification.

@@ -297,11 +297,14 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
         matrix->Factorize(Lambda, result.eta)) {
       const double lambda_min = estimate_lambda_min(result.eta);
       result.lambda_min_estimate = lambda_min;
-      const double tight = std::isfinite(lambda_min)
-                               ? std::max(eta_target, -1.1 * lambda_min)
-                               : std::numeric_limits<double>::infinity();
-      for (double c =
-               std::max(start, std::min(double_start(lambda_min), result.eta));
+      // Without an estimate (Lanczos did not converge) there is nothing to
+      // tighten towards: no proof is tried.
+      const bool estimated = std::isfinite(lambda_min);
+      const double inf = std::numeric_limits<double>::infinity();
+      const double tight =
+          estimated ? std::max(eta_target, -1.1 * lambda_min) : inf;
+      const double first_shift = estimated ? double_start(lambda_min) : inf;
+      for (double c = std::max(start, std::min(first_shift, result.eta));
            c < result.eta && !result.out_of_time; c *= 8) {
         if (prove(c, ProofPrecision::kDouble)) break;
       }
