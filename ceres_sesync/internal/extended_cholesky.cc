@@ -464,8 +464,9 @@ void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
     factor_start_[k + 1] = factor_start_[k] + count[k];
     flops_ += 0.5 * count[k] * static_cast<double>(count[k]);
   }
-  factor_row_.resize(factor_start_[n]);
-  // The supernodal factorization keeps L in its dense blocks instead.
+  // The simplicial factorization fills L's rows and values; the supernodal
+  // one keeps L in its dense blocks instead, with the rows per supernode.
+  factor_row_.assign(options_.supernodal ? 0 : factor_start_[n], 0);
   factor_value_.assign(options_.supernodal ? 0 : factor_start_[n],
                        DoubleDouble());
   super_hi_.clear();
@@ -480,24 +481,30 @@ void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
 
 void DoubleDoubleCholesky::AnalyzeSupernodes() {
   const int n = n_;
-  // The pattern of L by columns (rows increasing, diagonal first), by the
-  // same up-looking pass as the simplicial factorization.
+  // A's lower triangle by columns: the values of column i of L (entries
+  // (k, i), k >= i), by column (scatter_start_), with their rows.
+  scatter_start_.assign(n + 1, 0);
+  for (int k = 0; k < n; ++k) {
+    for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
+      ++scatter_start_[row_index_[p] + 1];
+    }
+  }
+  for (int i = 0; i < n; ++i) scatter_start_[i + 1] += scatter_start_[i];
+  std::vector<int> lower_row(row_index_.size());
+  scatter_source_.resize(row_index_.size());
   {
-    std::vector<int> next(factor_start_.begin(), factor_start_.end() - 1);
-    std::vector<int> mark(n, -1);
+    std::vector<int> next(scatter_start_.begin(), scatter_start_.end() - 1);
     for (int k = 0; k < n; ++k) {
-      factor_row_[next[k]++] = k;
-      mark[k] = k;
       for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
-        for (int i = row_index_[p]; mark[i] != k; i = parent_[i]) {
-          mark[i] = k;
-          factor_row_[next[i]++] = k;
-        }
+        const int slot = next[row_index_[p]]++;
+        lower_row[slot] = k;
+        scatter_source_[slot] = p;
       }
     }
   }
   // Fundamental supernodes: column j + 1 continues column j's supernode iff
-  // it is j's parent and has j's pattern minus j.
+  // it is j's parent and has j's pattern minus j (then their counts differ
+  // by one: the pattern of j minus j is contained in its parent's).
   auto count = [&](int j) { return factor_start_[j + 1] - factor_start_[j]; };
   super_start_.push_back(0);
   for (int j = 1; j < n; ++j) {
@@ -508,36 +515,96 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
   if (n > 0) super_start_.push_back(n);
   const int num_super = num_supernodes();
   column_super_.resize(n);
+  for (int s = 0; s < num_super; ++s) {
+    for (int j = super_start_[s]; j < super_start_[s + 1]; ++j) {
+      column_super_[j] = s;
+    }
+  }
+  std::vector<int> super_parent(num_super, -1);
+  for (int s = 0; s < num_super; ++s) {
+    const int up = parent_[super_start_[s + 1] - 1];
+    if (up >= 0) super_parent[s] = column_super_[up];
+  }
+  // The rows of each supernode, without forming L's pattern column by
+  // column: its columns, then the rows below them of A's columns in it and
+  // of its children's rows beyond their columns (Davis, "Direct Methods",
+  // Ch. 4: the pattern of column j is A's column j and the patterns of its
+  // elimination-tree children, minus the rows above j), sorted. Children
+  // have lower indices, so they are complete when their parent's turn
+  // comes. O(nnz(A) + sum of the supernodes' row counts) instead of
+  // O(nnz(L)).
+  std::vector<int> child_head(num_super, -1), child_next(num_super, -1);
+  for (int s = num_super - 1; s >= 0; --s) {
+    const int up = super_parent[s];
+    if (up >= 0) {
+      child_next[s] = child_head[up];
+      child_head[up] = s;
+    }
+  }
+  long long total_rows = 0;
+  for (int s = 0; s < num_super; ++s) total_rows += count(super_start_[s]);
+  super_row_.reserve(total_rows);
+  std::vector<int> mark(n, -1);
   super_row_start_.assign(1, 0);
   super_value_start_.assign(1, 0);
   for (int s = 0; s < num_super; ++s) {
-    const int first = super_start_[s];
-    const int ncols = super_start_[s + 1] - first;
-    for (int j = first; j < first + ncols; ++j) column_super_[j] = s;
-    super_row_.insert(super_row_.end(),
-                      factor_row_.begin() + factor_start_[first],
-                      factor_row_.begin() + factor_start_[first + 1]);
+    const int first = super_start_[s], last = super_start_[s + 1];
+    const int ncols = last - first;
+    for (int j = first; j < last; ++j) {
+      mark[j] = s;
+      super_row_.push_back(j);
+    }
+    const size_t below = super_row_.size();
+    for (int j = first; j < last; ++j) {
+      for (int q = scatter_start_[j]; q < scatter_start_[j + 1]; ++q) {
+        const int k = lower_row[q];
+        if (mark[k] != s) {
+          mark[k] = s;
+          super_row_.push_back(k);
+        }
+      }
+    }
+    for (int c = child_head[s]; c != -1; c = child_next[c]) {
+      const int c_cols = super_start_[c + 1] - super_start_[c];
+      for (int t = super_row_start_[c] + c_cols; t < super_row_start_[c + 1];
+           ++t) {
+        const int k = super_row_[t];
+        if (mark[k] != s) {
+          mark[k] = s;
+          super_row_.push_back(k);
+        }
+      }
+    }
+    std::sort(super_row_.begin() + below, super_row_.end());
     super_row_start_.push_back(static_cast<int>(super_row_.size()));
-    const long long nrows = count(first);
+    const long long nrows = super_row_start_[s + 1] - super_row_start_[s];
+    CHECK_EQ(nrows, count(first)) << "supernode " << s << ": its rows and "
+                                  << "the column count disagree";
     super_value_start_.push_back(super_value_start_.back() + nrows * ncols);
   }
   // The split for parallel factorization (tree_split.h), weighted by the
   // work each supernode's factorization step does: left-looking, column j's
   // update of its row at position p (diagonal 0) of its c rows costs c - p
-  // multiply-adds, done when the supernode holding that row is factored.
+  // multiply-adds, done when the supernode holding that row is factored. In
+  // supernode s (nrows rows, ncols columns) that is nrows - t for its row at
+  // position t, from each of its columns at or left of t: (t + 1) (nrows - t)
+  // for s itself (t < ncols), ncols (nrows - t) for the supernode of a row
+  // below. (Integers: the sums are exact in any order.)
   super_bin_.clear();
   if (flops_ >= options_.min_split_flops) {
     std::vector<double> work(num_super, 0.0);
-    for (int j = 0; j < n; ++j) {
-      const int c = count(j);
-      for (int p = 0; p < c; ++p) {
-        work[column_super_[factor_row_[factor_start_[j] + p]]] += c - p;
-      }
-    }
-    std::vector<int> super_parent(num_super, -1);
     for (int s = 0; s < num_super; ++s) {
-      const int up = parent_[super_start_[s + 1] - 1];
-      if (up >= 0) super_parent[s] = column_super_[up];
+      const int ncols = super_start_[s + 1] - super_start_[s];
+      const int begin = super_row_start_[s];
+      const int nrows = super_row_start_[s + 1] - begin;
+      for (int t = 0; t < nrows; ++t) {
+        const double remaining = nrows - t;
+        if (t < ncols) {
+          work[s] += (t + 1.0) * remaining;
+        } else {
+          work[column_super_[super_row_[begin + t]]] += ncols * remaining;
+        }
+      }
     }
     const TreeSplit split = SplitTree(super_parent, work, kTreeSplitBins,
                                       /*max_critical_fraction=*/0.85);
@@ -546,27 +613,11 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
             << split.heaviest_bin << (split.bin.empty() ? " (not split)" : "");
     super_bin_ = split.bin;
   }
-  // Where each input value goes: entry (k, i), k >= i, of A is in the column
-  // of supernode s = column_super_[i], at the position of row k.
-  value_destination_.assign(row_index_.size(), -1);
-  std::vector<int> lower_start(n + 1, 0);
-  for (int k = 0; k < n; ++k) {
-    for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
-      ++lower_start[row_index_[p] + 1];
-    }
-  }
-  for (int i = 0; i < n; ++i) lower_start[i + 1] += lower_start[i];
-  std::vector<int> lower_row(row_index_.size()), lower_value(row_index_.size());
-  {
-    std::vector<int> next(lower_start.begin(), lower_start.end() - 1);
-    for (int k = 0; k < n; ++k) {
-      for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
-        const int slot = next[row_index_[p]]++;
-        lower_row[slot] = k;
-        lower_value[slot] = p;
-      }
-    }
-  }
+  // Where each input value goes: entry (k, i), k >= i, of A is in column i
+  // of L, in supernode s = column_super_[i], at the position of row k. Each
+  // column is filled by the thread that factors it, right before its
+  // updates (FactorizeSupernodal).
+  scatter_destination_.resize(row_index_.size());
   std::vector<int> position(n, -1);
   for (int s = 0; s < num_super; ++s) {
     const int first = super_start_[s];
@@ -574,10 +625,10 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
     const int* rows = super_row_.data() + super_row_start_[s];
     for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
     for (int j = first; j < super_start_[s + 1]; ++j) {
-      for (int q = lower_start[j]; q < lower_start[j + 1]; ++q) {
-        value_destination_[lower_value[q]] =
-            super_value_start_[s] + static_cast<long long>(j - first) * nrows +
-            position[lower_row[q]];
+      for (int q = scatter_start_[j]; q < scatter_start_[j + 1]; ++q) {
+        scatter_destination_[q] = super_value_start_[s] +
+                                  static_cast<long long>(j - first) * nrows +
+                                  position[lower_row[q]];
       }
     }
   }
@@ -589,20 +640,39 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   const int num_super = num_supernodes();
   const Kernels kernels = vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2}
                                       : Kernels{UpdatePortable, ScalePortable};
-  // The dense blocks, kept as the factor (allocated once per analysis: on
-  // the virtual machines measured, first touching fresh pages cost more than
-  // this whole loop).
+  // The dense blocks, kept as the factor: allocated once per analysis and
+  // left unwritten here. Each column is zeroed and filled with its values
+  // by the thread that factors it (fill_columns below), so that the first
+  // touch of fresh pages, which costs more than this whole loop on the
+  // virtual machines measured, is spread over the threads.
   factor_value_.clear();
   HugePageVector<double>& super_hi = super_hi_;
   HugePageVector<double>& super_lo = super_lo_;
-  super_hi.assign(supernodal_entries(), 0.0);
-  super_lo.assign(supernodal_entries(), 0.0);
-  for (size_t p = 0; p < values.size(); ++p) {
-    // Renormalized (the same value): the kernels' bounds assume it.
-    const DoubleDouble v = dd::TwoSum(values[p].hi, values[p].lo);
-    super_hi[value_destination_[p]] = v.hi;
-    super_lo[value_destination_[p]] = v.lo;
+  const size_t entries = static_cast<size_t>(supernodal_entries());
+  if (super_hi.size() != entries) {
+    HugePageVector<double>().swap(super_hi);
+    HugePageVector<double>().swap(super_lo);
+    super_hi.resize(entries);  // Default-initialized: not written.
+    super_lo.resize(entries);
   }
+  // Zeros columns c0 .. c1 - 1 of supernode s (nrows rows, values s_hi and
+  // s_lo) and scatters A's values into them.
+  auto fill_columns = [&](int s, int c0, int c1, int nrows, double* s_hi,
+                          double* s_lo) {
+    const int first = super_start_[s];
+    std::fill(s_hi + static_cast<long long>(c0) * nrows,
+              s_hi + static_cast<long long>(c1) * nrows, 0.0);
+    std::fill(s_lo + static_cast<long long>(c0) * nrows,
+              s_lo + static_cast<long long>(c1) * nrows, 0.0);
+    for (int q = scatter_start_[first + c0]; q < scatter_start_[first + c1];
+         ++q) {
+      // Renormalized (the same value): the kernels' bounds assume it.
+      const DoubleDouble& value = values[scatter_source_[q]];
+      const DoubleDouble v = dd::TwoSum(value.hi, value.lo);
+      super_hi[scatter_destination_[q]] = v.hi;
+      super_lo[scatter_destination_[q]] = v.lo;
+    }
+  };
   // Left-looking: supernode d, once factored, waits in the list of the
   // supernode holding its next row below the ones already applied
   // (pointer[d]), which it updates when that one's turn comes. With a split
@@ -730,6 +800,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
           return std::clamp(static_cast<int>(c), 0, ncols);
         };
         const int c0 = column_begin(part), c1 = column_begin(part + 1);
+        fill_columns(s, c0, c1, nrows, s_hi, s_lo);
         for (int d : list) {
           const int* d_rows = super_row_.data() + super_row_start_[d];
           const int p1 = pointer[d], p2 = rows_in_s(d);
@@ -865,6 +936,19 @@ DoubleDouble DoubleDoubleCholesky::Entry(int c, int t) const {
   const long long nrows = super_row_start_[s + 1] - super_row_start_[s];
   const long long at = super_value_start_[s] + jj * nrows + jj + t;
   return DoubleDouble(super_hi_[at], super_lo_[at]);
+}
+
+const HugePageVector<int>& DoubleDoubleCholesky::factor_row() const {
+  if (options_.supernodal && factor_row_.empty() && n_ > 0) {
+    factor_row_.resize(factor_start_[n_]);
+    for (int c = 0; c < n_; ++c) {
+      const int s = column_super_[c], jj = c - super_start_[s];
+      std::copy(super_row_.begin() + super_row_start_[s] + jj,
+                super_row_.begin() + super_row_start_[s + 1],
+                factor_row_.begin() + factor_start_[c]);
+    }
+  }
+  return factor_row_;
 }
 
 const std::vector<DoubleDouble>& DoubleDoubleCholesky::factor_value() const {

@@ -105,7 +105,9 @@ class DoubleDoubleCholesky {
   // scheme keeps L in its dense blocks: factor_value() copies it out on its
   // first call after a factorization (for inspection and tests).
   const std::vector<int>& factor_start() const { return factor_start_; }
-  const HugePageVector<int>& factor_row() const { return factor_row_; }
+  // The supernodal scheme keeps L's rows per supernode: factor_row() lists
+  // them by column on its first call after Analyze().
+  const HugePageVector<int>& factor_row() const;
   const std::vector<DoubleDouble>& factor_value() const;
   // Multiply-adds of one factorization: sum over columns of count^2 / 2.
   double flops() const { return flops_; }
@@ -132,9 +134,20 @@ class DoubleDoubleCholesky {
   DoubleDouble Entry(int c, int t) const;
   template <typename F>
   void ForEachEntry(int c, F&& f) const {
-    for (int p = factor_start_[c]; p < factor_start_[c + 1]; ++p) {
-      f(factor_row_[p], Entry(c, p - factor_start_[c]));
+    if (!options_.supernodal) {
+      for (int p = factor_start_[c]; p < factor_start_[c + 1]; ++p) {
+        f(factor_row_[p], factor_value_[p]);
+      }
+      return;
     }
+    const int s = column_super_[c], jj = c - super_start_[s];
+    const int* rows = super_row_.data() + super_row_start_[s];
+    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const long long at =
+        super_value_start_[s] + static_cast<long long>(jj) * nrows;
+    const double* hi = super_hi_.data() + at;
+    const double* lo = super_lo_.data() + at;
+    for (int t = jj; t < nrows; ++t) f(rows[t], DoubleDouble(hi[t], lo[t]));
   }
   bool FactorizeSupernodal(const std::vector<DoubleDouble>& values,
                            std::chrono::steady_clock::time_point deadline);
@@ -145,7 +158,9 @@ class DoubleDoubleCholesky {
   std::vector<int> column_start_, row_index_;  // The upper triangle of A.
   std::vector<int> parent_;                    // Elimination tree.
   std::vector<int> factor_start_;              // Column pointers of L.
-  HugePageVector<int> factor_row_;             // Row indices of L.
+  // Row indices of L (simplicial; for the supernodal scheme a copy made by
+  // factor_row() on demand).
+  mutable HugePageVector<int> factor_row_;
   // Values of L (simplicial; for the supernodal scheme a copy made by
   // factor_value() on demand).
   mutable std::vector<DoubleDouble> factor_value_;
@@ -165,7 +180,11 @@ class DoubleDoubleCholesky {
   std::vector<int> column_super_;  // Supernode of each column.
   // Bin of each supernode (-1: top) of the parallel factorization, or empty.
   std::vector<int> super_bin_;
-  std::vector<long long> value_destination_;  // Input value -> block entry.
+  // Input values by the column of L they are in: those of column j are
+  // scatter_source_[q] for q in scatter_start_[j] .. scatter_start_[j+1] - 1,
+  // at block entry scatter_destination_[q].
+  std::vector<int> scatter_start_, scatter_source_;
+  std::vector<long long> scatter_destination_;
 };
 
 }  // namespace ceres_sesync::internal

@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <utility>
 #include <vector>
 
 #if defined(__has_feature)
@@ -75,6 +76,18 @@ struct HugePageAllocator {
     std::allocator<T>().deallocate(p, n);
   }
 
+  // Value-less construction default-initializes: resize(n) and vector(n)
+  // leave arithmetic elements unwritten (callers fill them; a fresh mapped
+  // block is then first touched where it is filled). assign(n, value) and
+  // the other constructors write as usual.
+  template <typename U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
   template <typename U>
   bool operator==(const HugePageAllocator<U>&) const {
     return true;
