@@ -14,8 +14,14 @@
 #include <fstream>
 #include <sstream>
 
+#include "ceres_sesync/process_memory.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
+
+DEFINE_bool(keep_freed_memory, true,
+            "Keep freed memory in the process (KeepFreedMemory(), "
+            "process_memory.h) for every method alike; false: glibc's "
+            "defaults.");
 
 namespace ceres_sesync::bench {
 
@@ -116,6 +122,9 @@ std::string CeresStatus(const CeresBaselineSummary& summary) {
 
 void InitBenchProgram(int* argc, char*** argv) {
   gflags::ParseCommandLineFlags(argc, argv, /*remove_flags=*/true);
+  if (FLAGS_keep_freed_memory && !KeepFreedMemory()) {
+    std::fprintf(stderr, "note: KeepFreedMemory() not available here\n");
+  }
   google::InitGoogleLogging((*argv)[0]);
   FLAGS_logtostderr = true;
   if (FLAGS_minloglevel < google::GLOG_WARNING) {

@@ -61,6 +61,7 @@
 #include "ceres_sesync/outlier_generator.h"
 #include "ceres_sesync/pose_conversions.h"
 #include "ceres_sesync/pose_graph.h"
+#include "ceres_sesync/process_memory.h"
 #include "ceres_sesync/riemannian_trust_region.h"
 #include "ceres_sesync/robust_solver.h"
 #include "ceres_sesync/sesync_solver.h"

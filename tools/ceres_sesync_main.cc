@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "ceres_sesync/process_memory.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 #include "tools/commands.h"
@@ -331,6 +332,8 @@ bool FlagIsSet(const char* name) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Freed memory stays for the next factorization (process_memory.h).
+  ceres_sesync::KeepFreedMemory();
   gflags::SetUsageMessage(GeneralHelp());
   gflags::SetVersionString(CERES_SESYNC_VERSION);
   if (!CheckFlagNames(argc, argv)) return kUsageOrInputError;
