@@ -45,6 +45,7 @@ from ._ceres_sesync import (
     SolverOptions,
     SolverProgress,
     SolverSummary,
+    keep_freed_memory,
 )
 
 __version__ = _core.__version__
@@ -78,6 +79,7 @@ __all__ = [
     "generate_city",
     "generate_cube",
     "generate_landmarks",
+    "keep_freed_memory",
     "read_g2o",
     "read_g2o_poses",
     "read_g2o_solution",

@@ -25,6 +25,7 @@
 #include "ceres_sesync/g2o_io.h"
 #include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/pose_graph.h"
+#include "ceres_sesync/process_memory.h"
 #include "ceres_sesync/robust_solver.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "glog/logging.h"
@@ -800,6 +801,11 @@ void BindCube(py::module_& m) {
       .rw("spacing", &O::spacing)
       .rw("seed", &O::seed);
   KeywordInit<O>(cls, "CubeOptions");
+  m.def("keep_freed_memory", &KeepFreedMemory,
+        "Process-wide: keep freed memory in the process for the next solve "
+        "(ceres_sesync::KeepFreedMemory, process_memory.h). Call once, "
+        "before solving many graphs; returns False where it is not "
+        "available (not glibc).");
   m.def("_generate_cube", [](const O& options) {
     PoseGraph graph;
     Poses truth;
