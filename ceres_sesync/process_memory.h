@@ -8,14 +8,19 @@
 // allocates and frees its matrices, factors and work vectors, so the next
 // factorization, and the next solve, first-touch fresh pages again: one page
 // fault per 4 KiB, and the kernel zeroes each page. Where faults are
-// expensive that is a large share of a small solve. Measured on the
-// paravirtualized 2-core machine of bench/ (a fault there costs ~12 us),
-// repeated solves of CSAIL (1045 poses): ~280 faults per solve, about 3 ms
-// of 8 (bench/results/process_memory/).
+// expensive that costs a large share of the time. Measured on the
+// paravirtualized 2-core machine of bench/ (a fault there costs ~12 us;
+// bench/results/process_memory/): repeated solves of kitti_00 (4541 poses),
+// 2462 faults per solve and certify, about 40% of their time, and none
+// with this setting. One solve of a 10^6-pose city: 20.3M faults and 865 s
+// with the thresholds below alone (its n x 5 matrices, 40 MB each, were
+// still mapped and unmapped at every product), 2.8M and 629 s with block
+// mapping off as well.
 //
-// KeepFreedMemory() sets M_MMAP_THRESHOLD to 32 MiB (glibc's largest) and
-// M_TRIM_THRESHOLD to 2 GiB - 1: blocks up to 32 MiB come from the heaps, and
-// freed memory stays with the process for the next allocation. The price is
+// KeepFreedMemory() sets M_MMAP_THRESHOLD to 32 MiB (glibc's largest),
+// M_MMAP_MAX to 0 (no block is mapped on its own, whatever its size) and
+// M_TRIM_THRESHOLD to 2 GiB - 1: every block comes from the heaps, and freed
+// memory stays with the process for the next allocation. The price is
 // that the process keeps its peak heap size until it exits. Large numeric
 // buffers that the library maps itself (huge_page_allocator.h) are not
 // affected.

@@ -1,7 +1,7 @@
-// KeepFreedMemory: a block above glibc's default mmap threshold comes from
-// the heap, and freeing it leaves the heap at its size (no trim); without
-// the call (a separate process: each test runs in its own) the same block
-// is mapped on its own, so the second test fails if the setting is lost.
+// KeepFreedMemory: a 48 MiB block (above every mmap threshold glibc accepts)
+// comes from the heap, and freeing it leaves the heap at its size (no trim);
+// without the call (a separate process: each test runs in its own) the same
+// block is mapped on its own, so the second test fails if the setting is lost.
 // ctest runs each test in a process of its own; run directly, the binary
 // runs them in this order (the setting is process-wide).
 
@@ -29,7 +29,9 @@ namespace ceres_sesync {
 namespace {
 
 #if defined(__GLIBC__) && !defined(CERES_SESYNC_SANITIZED_ALLOCATOR)
-constexpr size_t kBlock = size_t{4} << 20;  // Above 128 KiB, below 32 MiB.
+// Above glibc's default mmap threshold (128 KiB) and above the largest one it
+// accepts (32 MiB): only M_MMAP_MAX = 0 keeps such a block in the heap.
+constexpr size_t kBlock = size_t{48} << 20;
 
 // Allocates and touches kBlock bytes, frees them, and reports the mapped
 // bytes while it was allocated and the heap size before and after the free.

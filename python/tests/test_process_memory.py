@@ -1,6 +1,7 @@
-"""keep_freed_memory(): after it, a 4 MiB block comes from the heap and its
-free leaves the heap at its size; without it glibc maps such a block on its
-own. Each case runs in a fresh interpreter (the setting is process-wide)."""
+"""keep_freed_memory(): after it, a 48 MiB block (above the largest mmap
+threshold glibc accepts) comes from the heap and its free leaves the heap at
+its size; without it glibc maps such a block on its own. Each case runs in a
+fresh interpreter (the setting is process-wide)."""
 
 import ctypes.util
 import os
@@ -24,7 +25,7 @@ libc.malloc.restype = ctypes.c_void_p
 libc.malloc.argtypes = [ctypes.c_size_t]
 libc.free.argtypes = [ctypes.c_void_p]
 kept = cs.keep_freed_memory() if sys.argv[1] == "keep" else None
-size = 4 << 20
+size = 48 << 20
 mapped_before = libc.mallinfo2().hblkhd
 block = libc.malloc(size)
 ctypes.memset(block, 1, size)
@@ -64,4 +65,4 @@ def test_keep_freed_memory_keeps_blocks_in_the_heap():
 def test_without_it_glibc_maps_the_block():
     kept, mapped, _ = probe("default")
     assert kept == "None"
-    assert mapped >= 4 << 20
+    assert mapped >= 48 << 20
