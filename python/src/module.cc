@@ -801,11 +801,6 @@ void BindCube(py::module_& m) {
       .rw("spacing", &O::spacing)
       .rw("seed", &O::seed);
   KeywordInit<O>(cls, "CubeOptions");
-  m.def("keep_freed_memory", &KeepFreedMemory,
-        "Process-wide: keep freed memory in the process for the next solve "
-        "(ceres_sesync::KeepFreedMemory, process_memory.h). Call once, "
-        "before solving many graphs; returns False where it is not "
-        "available (not glibc).");
   m.def("_generate_cube", [](const O& options) {
     PoseGraph graph;
     Poses truth;
@@ -1183,4 +1178,10 @@ PYBIND11_MODULE(_ceres_sesync, m) {
   BindLandmarkGenerator(m);
   BindSolvers(m);
   BindRobust(m);
+  // Process-wide, so the module never calls it itself (process_memory.h).
+  m.def("keep_freed_memory", &ceres_sesync::KeepFreedMemory,
+        "Process-wide: keep freed memory in the process for the next solve "
+        "(ceres_sesync::KeepFreedMemory, process_memory.h). Call once, "
+        "before solving many graphs; returns False where it is not "
+        "available (not glibc).");
 }
