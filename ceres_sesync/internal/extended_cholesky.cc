@@ -899,8 +899,10 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
   // the factor (1 + 1e-6) covers the rounding of this computation for up to
   // 10^9 terms (gamma_{10^9} < 1.2e-7).
   std::vector<double> column_sum(n_, 0.0), v(n_, 0.0);
+  double max_pivot = 1;  // For the underflow term below.
   for (int c = 0; c < n_; ++c) {
-    ForEachEntry(c, [&](int, const DoubleDouble& l) {
+    ForEachEntry(c, [&](int row, const DoubleDouble& l) {
+      if (row == c) max_pivot = std::max(max_pivot, l.AbsUpperBound());
       column_sum[c] += l.AbsUpperBound();
     });
   }
@@ -913,12 +915,8 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
   // operations, each erring by at most kUnderflowError absolutely, scaled by
   // the pivot l_jj it is multiplied with (the backward error of l_ij is
   // l_jj times its forward error).
-  int max_count = 0;
-  double max_pivot = 1;
-  for (int c = 0; c < n_; ++c) {
-    max_count = std::max(max_count, row_count_[c]);
-    max_pivot = std::max(max_pivot, Entry(c, 0).AbsUpperBound());
-  }
+  const int max_count =
+      n_ > 0 ? *std::max_element(row_count_.begin(), row_count_.end()) : 0;
   const double underflow_per_entry =
       (max_count + 2.0) * kUnderflowError * max_pivot * (1 + 1e-6);
   rho->resize(n_);
@@ -928,14 +926,6 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
     (*rho)[i] = DoubleDoubleGamma(row_count_[i] + 1) * v[i] * (1 + 1e-6) +
                 entries * underflow_per_entry;
   }
-}
-
-DoubleDouble DoubleDoubleCholesky::Entry(int c, int t) const {
-  if (!options_.supernodal) return factor_value_[factor_start_[c] + t];
-  const int s = column_super_[c], jj = c - super_start_[s];
-  const long long nrows = super_row_start_[s + 1] - super_row_start_[s];
-  const long long at = super_value_start_[s] + jj * nrows + jj + t;
-  return DoubleDouble(super_hi_[at], super_lo_[at]);
 }
 
 const HugePageVector<int>& DoubleDoubleCholesky::factor_row() const {

@@ -129,9 +129,8 @@ class DoubleDoubleCholesky {
 
  private:
   void AnalyzeSupernodes();
-  // Entry t (0: the diagonal) of column c of L, in either layout, and f(row,
-  // value) for every entry of column c in order.
-  DoubleDouble Entry(int c, int t) const;
+  // f(row, value) for every entry of column c of L in order (the diagonal
+  // first), in either layout.
   template <typename F>
   void ForEachEntry(int c, F&& f) const {
     if (!options_.supernodal) {
