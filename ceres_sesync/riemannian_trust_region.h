@@ -104,9 +104,12 @@ struct RiemannianTrustRegionOptions {
   double tcg_tolerance_fraction = 0.1;
   // Wall-clock limit in seconds (<= 0: none).
   double max_time_s = 0;
-  // Called after every outer iteration; return false to stop.
+  // Called after every accepted step (outer iteration); return false to
+  // stop. `hessian_vector_products`: those since the previous call, i.e. of
+  // this step's truncated-CG solve and of the solves of any steps rejected
+  // on the way to it.
   std::function<bool(int iteration, double f, double gradient_norm,
-                     double trust_radius, int inner_iterations)>
+                     double trust_radius, int hessian_vector_products)>
       callback;
 };
 

@@ -289,10 +289,10 @@ TEST(RiemannianTrustRegion, CallbackCanStopAndSeesDecreasingCosts) {
   std::vector<double> costs;
   std::vector<int> iterations;
   options.callback = [&](int iteration, double f, double gradient_norm,
-                         double trust_radius, int inner_iterations) {
+                         double trust_radius, int hessian_vector_products) {
     EXPECT_TRUE(std::isfinite(gradient_norm));
     EXPECT_GT(trust_radius, 0);
-    EXPECT_GE(inner_iterations, 1);
+    EXPECT_GE(hessian_vector_products, 1);
     costs.push_back(f);
     iterations.push_back(iteration);
     return costs.size() < 2;
@@ -349,6 +349,34 @@ TEST(RiemannianTrustRegion, NanTrialCostsShrinkTheTrustRegion) {
   EXPECT_LE((x - x0).norm(), 1e-2);
   EXPECT_TRUE(std::isfinite(summary.final_cost));
   EXPECT_LE(summary.final_cost, summary.initial_cost);
+}
+
+// The callback's product counts include the truncated-CG solves of steps
+// rejected on the way to each accepted one (the staircase schedules its
+// certificate tests by them): stopped by the callback, they add up to the
+// summary's total. The NaN ball forces rejections before the first
+// acceptance, so counting only accepted steps' solves would fall short.
+TEST(RiemannianTrustRegion, CallbackProductsIncludeRejectedSteps) {
+  std::mt19937_64 rng(6);
+  const MatrixXd A = RandomSpd(10, 10.0, &rng);
+  MatrixXd x = RandomStiefel(10, 1, &rng);
+  NanOutsideBallCost cost(A, x, 1e-2);
+  RiemannianTrustRegionOptions options;
+  options.max_time_s = 2.0;  // Safety net.
+  int calls = 0, products = 0;
+  double first_radius = 0;
+  options.callback = [&](int, double, double, double radius, int hv) {
+    if (calls++ == 0) first_radius = radius;
+    products += hv;
+    return calls < 3;
+  };
+  RiemannianTrustRegionSummary summary;
+  MinimizeRiemannianTrustRegion(options, &cost, &x, &summary);
+  ASSERT_EQ(summary.termination, Termination::kUserCallback);
+  EXPECT_EQ(products, summary.hessian_vector_products);
+  // Rejections did happen: the radius shrank (by 4 per rejection) far
+  // below the first Cauchy step's length before a step was accepted.
+  EXPECT_LT(first_radius, 1e-2);
 }
 
 TEST(RiemannianTrustRegion, TimeLimit) {

@@ -469,17 +469,17 @@ void Staircase::Optimize(int rank, bool test_certificate, Eigen::MatrixXd* Y,
       test_certificate && options_.test_certificate_after_escape && !use_ceres;
   int level_products = 0, last_test_products = 0;
   double test_seconds = 0;
-  rtr.callback = [&](int it, double f, double g, double radius, int inner) {
+  rtr.callback = [&](int it, double f, double g, double radius, int products) {
     if (options_.verbose) {
       LOG(INFO) << "rank " << rank << " iter " << it << " F " << f << " |grad| "
-                << g << " radius " << radius << " tCG " << inner;
+                << g << " radius " << radius << " Hv " << products;
     }
     Progress("optimize", rank, level->iterations + it, f, g);
     if (options_.callback && !options_.callback(rank, it, f, g, radius)) {
       return false;
     }
     if (!test_during) return true;
-    level_products += inner;
+    level_products += products;
     const double eta =
         Shift(0.5 * options_.certification_max_relative_bound, f);
     ProofPrecision precision;
