@@ -123,7 +123,8 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
   Eigen::MatrixXd g, pg, x_new;
   double radius = options.initial_trust_radius;
   double reference_norm = 1, initial_radius = 1;
-  int products_since_callback = 0;  // For options.callback.
+  // summary->hessian_vector_products at the last callback.
+  int products_at_callback = 0;
   bool switched = false;  // The preconditioner changed (UpdatePreconditioner).
   auto finish = [&](Termination t) {
     summary->termination = t;
@@ -175,7 +176,6 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
             return options.max_time_s > 0 && elapsed() >= options.max_time_s;
           });
       summary->hessian_vector_products += step.iterations;
-      products_since_callback += step.iterations;
       switched |=
           cost->UpdatePreconditioner(step.iterations, /*converged=*/false);
       const double model_decrease =
@@ -208,8 +208,9 @@ void MinimizeRiemannianTrustRegion(const RiemannianTrustRegionOptions& options,
         *x = x_new;
         f = f_new;
         summary->iterations = k + 1;
-        const int products = products_since_callback;
-        products_since_callback = 0;
+        const int products =
+            summary->hessian_vector_products - products_at_callback;
+        products_at_callback = summary->hessian_vector_products;
         if (options.callback &&
             !options.callback(k + 1, f, g_norm, radius, products)) {
           cost->Gradient(&g);
