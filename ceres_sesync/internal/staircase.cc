@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 #include <utility>
+#include <vector>
 
 #include "ceres_sesync/internal/ceres_local_solver.h"
 #include "ceres_sesync/internal/chordal.h"
@@ -442,9 +443,33 @@ bool Staircase::TestCertificate(double eta, ProofPrecision precision,
   return passed;
 }
 
-void Staircase::Optimize(int rank, bool test_certificate, Eigen::MatrixXd* Y,
-                         SolverSummary::Level* level) {
+void Staircase::Optimize(int rank, bool test_certificate,
+                         Eigen::MatrixXd* Y_full, SolverSummary::Level* level) {
   SESyncCost& cost = *cost_;
+  // Rows of Y that are exactly zero stay zero under every operation of the
+  // local search (products with Q, the preconditioner, tangent projections
+  // and retractions act on each row linearly, or mix only the d columns of
+  // a block): the padding of a rank-d initialization, and the rows an
+  // escape from such a level leaves at zero. A chordal start at rank d + 2
+  // is the rank-d problem, and the level after an escape from it is of
+  // rank d + 1. So the level is optimized on its other rows only: the same
+  // iterates up to round-off, each product costing (d + 1) / (d + 3) ..
+  // d / (d + 2) of the padded one's. The zero rows are put back after.
+  std::vector<int> rows;
+  for (int i = 0; i < Y_full->rows(); ++i) {
+    if (!Y_full->row(i).isZero(0)) rows.push_back(i);
+  }
+  const bool compact = static_cast<int>(rows.size()) < Y_full->rows() &&
+                       static_cast<int>(rows.size()) >= d_;
+  Eigen::MatrixXd Y_compact;
+  Eigen::MatrixXd* Y = Y_full;
+  if (compact) {
+    Y_compact.resize(rows.size(), Y_full->cols());
+    for (size_t k = 0; k < rows.size(); ++k) {
+      Y_compact.row(k) = Y_full->row(rows[k]);
+    }
+    Y = &Y_compact;
+  }
   // The gradient tolerance is relative to the final F, so repeat (cheaply,
   // from the current point) if F dropped below the guess.
   double f = cost.Evaluate(*Y);
@@ -529,7 +554,14 @@ void Staircase::Optimize(int rank, bool test_certificate, Eigen::MatrixXd* Y,
     level->termination = "certificate test passed";
   }
   level->verify_time_s += test_seconds;  // The tests' time is verification.
-  cost.Evaluate(*Y);                     // Make Y current (Lambda at Y).
+  if (compact) {
+    Y_full->setZero();
+    for (size_t k = 0; k < rows.size(); ++k) {
+      Y_full->row(rows[k]) = Y_compact.row(k);
+    }
+    Y = Y_full;
+  }
+  cost.Evaluate(*Y);  // Make Y current (Lambda at Y).
   if (use_ceres) {
     Eigen::MatrixXd gradient;
     cost.Gradient(&gradient);
