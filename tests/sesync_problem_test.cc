@@ -652,13 +652,6 @@ TEST(SESyncCost, HessianMatchesFiniteDifferencesAndIsSymmetric) {
   }
 }
 
-// ReleaseNumericFactor() frees the values and keeps the symbolic analysis:
-// a copy taken before stays valid, and refactorizing (simplicial or
-// supernodal) gives the same factor to the last bit.
-// With two threads the vertex ordering is computed beside the assembly (at
-// 5000 vertices and more): the same permutation, and so bitwise the same
-// products, as with one thread; for a pose graph and for one with landmarks
-// and position priors (whose couplings the pattern must include).
 // The staircase optimizes a level on the rows of Y that are not exactly zero
 // (Staircase::Optimize): the padding of a chordal start at rank d + 2, and
 // the zero rows an escape from such a level keeps. That rests on the trust
@@ -739,6 +732,10 @@ TEST(SESyncCost, TrustRegionKeepsZeroRowsZeroAndMatchesTheCompactRun) {
   }
 }
 
+// With two threads the vertex ordering is computed beside the assembly (at
+// 5000 vertices and more): the same permutation, and so bitwise the same
+// products, as with one thread; for a pose graph and for one with landmarks
+// and position priors (whose couplings the pattern must include).
 TEST(SESyncProblem, OrderingAndProductsDoNotDependOnThreadCount) {
   CityOptions city;
   city.num_poses = 6000;
@@ -773,6 +770,9 @@ TEST(SESyncProblem, OrderingAndProductsDoNotDependOnThreadCount) {
   }
 }
 
+// ReleaseNumericFactor() frees the values and keeps the symbolic analysis:
+// a copy taken before stays valid, and refactorizing (simplicial or
+// supernodal) gives the same factor to the last bit.
 TEST(CholmodFactor, ReleaseKeepsAnalysisAndCopies) {
   std::mt19937_64 rng(41);
   for (const PoseGraph& graph : CostGraphs()) {
