@@ -179,14 +179,16 @@ struct SolverOptions {
   // factorization's cost in products (CHOLMOD's flop prediction, a
   // double-double test priced at 1.5 double ones; not a time, so results
   // do not depend on the machine's load or the thread count) and half the
-  // level's products so far (the 10^6-pose city: certified after 175
-  // rank-5 products, 540 s in all). The level stops at the first test that
-  // passes; its proof stands, and the level's verification tightens it in
-  // double where double reaches below it. The returned poses are the same
-  // (rounding refines them to the same local optimum); the proven bound is
-  // within the tolerance but can be looser than after a converged descent
-  // (large maps, where only double-double reaches it: about half the
-  // tolerance). Off: every level runs to the local solver's tests.
+  // level's products so far (the 10^6-pose city: certified after 175 or
+  // 491 rank-5 products, on two trajectories that differ in round-off: a
+  // test's outcome near the tolerance is marginal). The level stops at the
+  // first test that passes; its proof stands, and the level's verification
+  // tightens it in double where double reaches below it. The returned poses
+  // are the same (rounding refines them to the same local optimum); the
+  // proven bound is within the tolerance but can be looser than after a
+  // converged descent (large maps, where only double-double reaches it:
+  // about half the tolerance). Off: every level runs to the local solver's
+  // tests.
   bool test_certificate_after_escape = true;
 
   // Threads for the products with Q, the triangular solves (two subtrees of

@@ -558,8 +558,8 @@ void Staircase::Optimize(int rank, bool test_certificate,
     level->termination = "certificate test passed";
   }
   level->verify_time_s += test_seconds;  // The tests' time is verification.
+  // Back into Y_full, whose other rows are still zero.
   if (compact) {
-    Y_full->setZero();
     for (size_t k = 0; k < rows.size(); ++k) {
       Y_full->row(rows[k]) = Y_compact.row(k);
     }
