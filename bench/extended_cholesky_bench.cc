@@ -44,6 +44,9 @@ DEFINE_int32(repeats, 3, "Runs per measurement (the minimum is reported).");
 DEFINE_bool(simplicial, false, "Also time the simplicial reference (once).");
 DEFINE_bool(portable, false, "Also time the supernodal scheme without SIMD.");
 DEFINE_bool(cholmod, true, "Also time CHOLMOD's double factorization.");
+DEFINE_int32(threads, 1,
+             "Also time the double factorization on this many threads "
+             "(wall time).");
 DEFINE_int32(dense, 0,
              "Also time a dense N x N SPD matrix (the dense kernels alone).");
 
@@ -122,10 +125,12 @@ struct Timing {
   double analyze = 0, factorize = 1e300;
 };
 
-Timing TimeDoubleDouble(DoubleDoubleCholesky* chol, int size,
-                        const std::vector<int>& start,
-                        const std::vector<int>& row,
-                        const std::vector<DoubleDouble>& values, int repeats) {
+// Values: DoubleDouble or double (the same scheme in double).
+template <typename Value>
+Timing TimeFactorization(DoubleDoubleCholesky* chol, int size,
+                         const std::vector<int>& start,
+                         const std::vector<int>& row,
+                         const std::vector<Value>& values, int repeats) {
   Timing t;
   double begin = CpuNow();
   chol->Analyze(size, start, row);
@@ -136,6 +141,27 @@ Timing TimeDoubleDouble(DoubleDoubleCholesky* chol, int size,
     t.factorize = std::min(t.factorize, Seconds(begin));
   }
   return t;
+}
+
+// Wall-clock seconds (minimum over `repeats`) of a factorization on
+// `threads` threads.
+template <typename Value>
+double WallFactorization(int threads, int size, const std::vector<int>& start,
+                         const std::vector<int>& row,
+                         const std::vector<Value>& values, int repeats) {
+  DoubleDoubleCholesky::Options options;
+  options.num_threads = threads;
+  DoubleDoubleCholesky chol(options);
+  chol.Analyze(size, start, row);
+  double best = 1e300;
+  for (int r = 0; r < repeats; ++r) {
+    timespec a, b;
+    clock_gettime(CLOCK_MONOTONIC, &a);
+    CHECK(chol.Factorize(values)) << "not positive definite";
+    clock_gettime(CLOCK_MONOTONIC, &b);
+    best = std::min(best, b.tv_sec - a.tv_sec + 1e-9 * (b.tv_nsec - a.tv_nsec));
+  }
+  return best;
 }
 
 // max over entries of |a - b| / (largest |L_ij| of the row in a).
@@ -183,7 +209,7 @@ void RunDense(int n) {
   }
   DoubleDoubleCholesky chol;
   const Timing t =
-      TimeDoubleDouble(&chol, n, start, row, values, FLAGS_repeats);
+      TimeFactorization(&chol, n, start, row, values, FLAGS_repeats);
   std::printf(
       "dense %d: multiply-adds %.3g, factorize %.3f s (%.2f ns per "
       "multiply-add), SIMD %s\n",
@@ -228,7 +254,7 @@ void Run(const std::string& path) {
 
   DoubleDoubleCholesky supernodal;
   const Timing t_super =
-      TimeDoubleDouble(&supernodal, size, start, row, values, FLAGS_repeats);
+      TimeFactorization(&supernodal, size, start, row, values, FLAGS_repeats);
   const double flops = supernodal.flops();
   std::printf("%s: n %d, nnz(K) %lld, nnz(L) %lld, multiply-adds %.3g\n",
               path.c_str(), size, static_cast<long long>(K.nonZeros()),
@@ -268,12 +294,34 @@ void Run(const std::string& path) {
         name, t.analyze, t.factorize, 1e9 * t.factorize / flops);
   };
   report("double-double supernodal", t_super);
+  {
+    std::vector<double> double_values(values.size());
+    for (size_t q = 0; q < values.size(); ++q) {
+      double_values[q] = values[q].hi;
+    }
+    DoubleDoubleCholesky in_double;
+    const Timing t = TimeFactorization(&in_double, size, start, row,
+                                       double_values, FLAGS_repeats);
+    report("double supernodal", t);
+    std::printf("    double-double / double: %.2fx, max difference %.3g\n",
+                t_super.factorize / t.factorize,
+                FactorDifference(supernodal, in_double));
+    if (FLAGS_threads > 1) {
+      const double one =
+          WallFactorization(1, size, start, row, double_values, FLAGS_repeats);
+      const double many = WallFactorization(FLAGS_threads, size, start, row,
+                                            double_values, FLAGS_repeats);
+      std::printf("    wall time: 1 thread %.3f s, %d threads %.3f s (%.2fx)\n",
+                  one, FLAGS_threads, many, one / many);
+    }
+  }
   if (FLAGS_portable) {
     DoubleDoubleCholesky::Options options;
     options.vectorize = false;
     DoubleDoubleCholesky portable(options);
-    report("  portable (no SIMD)", TimeDoubleDouble(&portable, size, start, row,
-                                                    values, FLAGS_repeats));
+    report(
+        "  portable (no SIMD)",
+        TimeFactorization(&portable, size, start, row, values, FLAGS_repeats));
     std::printf("    difference from SIMD: %.3g\n",
                 FactorDifference(supernodal, portable));
   }
@@ -281,7 +329,8 @@ void Run(const std::string& path) {
     DoubleDoubleCholesky::Options options;
     options.supernodal = false;
     DoubleDoubleCholesky simplicial(options);
-    const Timing t = TimeDoubleDouble(&simplicial, size, start, row, values, 1);
+    const Timing t =
+        TimeFactorization(&simplicial, size, start, row, values, 1);
     report("double-double simplicial", t);
     std::printf(
         "    speed-up %.2fx, max difference %.3g (relative to the "

@@ -149,7 +149,8 @@ std::vector<GraphCase> Graphs() {
   chain.tau = 20;
   chain.seed = 77;
   graphs.push_back({"chain", test_util::RandomPoseGraph(chain, nullptr)});
-  // Dense loop closures: CHOLMOD picks a supernodal factor, and verification
+  // Dense loop closures: a supernodal-class factor (flops / nnz(L) above
+  // kSupernodalSwitch), and verification
   // takes the Lanczos-on-S path for clearly negative curvature.
   RandomGraphOptions dense;
   dense.dimension = 3;

@@ -393,6 +393,89 @@ TEST(ExtendedCholesky, SplitFactorizationIsSoundAndThreadIndependent) {
   }
 }
 
+// The same matrix with every value rounded to double, as double values.
+std::vector<double> RoundedValues(const Matrix& m) {
+  std::vector<double> values;
+  for (const DoubleDouble& v : m.value) values.push_back(v.hi + v.lo);
+  return values;
+}
+
+// The same scheme in double (Factorize() with double values): bitwise the
+// same factor on one and two threads (a split tree) and with and without
+// SIMD; the double-double factor's pattern and, within double's
+// resolution, its values (both backward stable; with condition numbers
+// below ~1e5 here the factors agree to ~1e5 k u of their rows' scale, the
+// tolerance is 1e-8); the true residual L L^T - A, in binary128, within
+// RowBackwardErrorBounds() (double's gamma), which is not vacuous; and
+// indefinite matrices rejected on every thread count.
+TEST(ExtendedCholesky, DoubleFactorizationIsSoundAndThreadIndependent) {
+  for (const Case& c : Cases()) {
+    Matrix m = c.matrix;
+    const std::vector<double> values = RoundedValues(m);
+    for (size_t q = 0; q < values.size(); ++q) m.value[q] = values[q];
+    DoubleDoubleCholesky::Options options;
+    options.min_split_flops = 0;
+    DoubleDoubleCholesky one(options), extended(options);
+    options.num_threads = 2;
+    DoubleDoubleCholesky two(options);
+    options.vectorize = false;
+    DoubleDoubleCholesky portable(options);
+    for (DoubleDoubleCholesky* chol : {&one, &two, &portable, &extended}) {
+      chol->Analyze(m.n, m.start, m.row);
+    }
+    ASSERT_TRUE(one.Factorize(values)) << c.name;
+    ASSERT_TRUE(two.Factorize(values)) << c.name;
+    ASSERT_TRUE(portable.Factorize(values)) << c.name;
+    ASSERT_TRUE(extended.Factorize(m.value)) << c.name;
+    EXPECT_FALSE(one.extended());
+    EXPECT_TRUE(extended.extended());
+    EXPECT_EQ(BitwiseDifferences(one, two), 0) << c.name;
+    EXPECT_EQ(BitwiseDifferences(one, portable), 0) << c.name;
+    ASSERT_EQ(one.factor_row(), extended.factor_row());
+    const std::vector<double> row_max = RowMax(extended);
+    double worst_difference = 0;
+    for (size_t p = 0; p < extended.factor_row().size(); ++p) {
+      EXPECT_EQ(one.factor_value()[p].lo, 0.0);
+      const Quad d =
+          ToQuad(one.factor_value()[p]) - ToQuad(extended.factor_value()[p]);
+      worst_difference =
+          std::max(worst_difference, static_cast<double>(Abs(d)) /
+                                         row_max[extended.factor_row()[p]]);
+    }
+    std::vector<double> rho;
+    two.RowBackwardErrorBounds(&rho);
+    const std::vector<double> residual = ResidualRowSums(two, m);
+    double worst_ratio = 0, max_rho = 0, max_a = 0;
+    for (int i = 0; i < m.n; ++i) {
+      worst_ratio = std::max(worst_ratio, residual[i] / rho[i]);
+      max_rho = std::max(max_rho, rho[i]);
+    }
+    for (double a : values) max_a = std::max(max_a, std::abs(a));
+    std::printf(
+        "%s (double): difference from double-double %.3g; residual / bound "
+        "%.3g, max bound / max |a| %.3g\n",
+        c.name, worst_difference, worst_ratio, max_rho / max_a);
+    EXPECT_LT(worst_difference, 1e-8) << c.name;
+    EXPECT_LE(worst_ratio, 1.0) << c.name;
+    EXPECT_GT(worst_ratio, 0.0) << c.name;
+    EXPECT_LT(max_rho, 1e-10 * max_a) << c.name;
+  }
+  // The smallest eigenvalue about -/+ 1e-8 (the shift) of entries ~10, far
+  // above double's resolution: rejected / factored.
+  for (int threads : {1, 2}) {
+    DoubleDoubleCholesky::Options options;
+    options.min_split_flops = 0;
+    options.num_threads = threads;
+    DoubleDoubleCholesky chol(options);
+    const Matrix negative = GridLaplacian(30, 30, 1, -1e-8, 4);
+    chol.Analyze(negative.n, negative.start, negative.row);
+    ASSERT_EQ(chol.num_bins(), 2);
+    EXPECT_FALSE(chol.Factorize(RoundedValues(negative))) << threads;
+    const Matrix positive = GridLaplacian(30, 30, 1, 1e-8, 4);
+    EXPECT_TRUE(chol.Factorize(RoundedValues(positive))) << threads;
+  }
+}
+
 // The SIMD kernels (when the CPU has them) and the portable code compute
 // bitwise the same factor.
 TEST(ExtendedCholesky, SimdAndPortableKernelsAgreeBitwise) {

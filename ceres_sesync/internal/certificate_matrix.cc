@@ -77,8 +77,22 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
   }
   SetData(K_);
   ordering_ = BlockOrdering(problem);
-  ConfigureCholmod(CholmodLayout::kAutomatic, &factor_);
-  factor_.AnalyzePatternWithOrdering(K_, ordering_);
+  InitializePermutedPattern();
+  DoubleDoubleCholesky::Options options;
+  options.num_threads = problem_.num_threads();
+  double_ = std::make_unique<DoubleDoubleCholesky>(options);
+  double_->Analyze(static_cast<int>(K_.rows()), permuted_start_, permuted_row_);
+}
+
+double CertificateMatrix::FactorizationCostInSolves(int r) const {
+  // Two flops per multiply-add; the solves' cost: 4 r nnz(L).
+  return 2 * double_->flops() /
+         (4.0 * r * std::max<double>(1, double_->factor_nonzeros()));
+}
+
+bool CertificateMatrix::supernodal() const {
+  return 2 * double_->flops() >=
+         kSupernodalSwitch * std::max<double>(1, double_->factor_nonzeros());
 }
 
 SparseMatrix CertificateMatrix::BaseMatrix() const {
@@ -194,24 +208,41 @@ double CertificateMatrix::PredictedSeconds(ProofPrecision precision) const {
                                     : 3.4 * last_double_seconds_;
 }
 
-void CertificateMatrix::FactorizeDouble() {
+bool CertificateMatrix::FactorizeDouble() {
   const auto start = std::chrono::steady_clock::now();
   ++double_factorizations_;
-  factor_.factorize(K_);
+  solver_.reset();
+  std::vector<double> values(K_.nonZeros());
+  for (int q = 0; q < K_.nonZeros(); ++q) {
+    values[permuted_index_[q]] = K_.valuePtr()[q];
+  }
+  double_factorized_ = double_->Factorize(values);
   last_double_seconds_ =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  if (factor_.info() == Eigen::Success) {
-    complete_double_seconds_ = last_double_seconds_;
-  }
+  if (double_factorized_) complete_double_seconds_ = last_double_seconds_;
+  return double_factorized_;
 }
 
 bool CertificateMatrix::Factorize(const Eigen::MatrixXd& Lambda, double c) {
   std::vector<double> unused;
   Assemble(Lambda, c, 0, &unused);
   factorized_shift_ = 0;
-  FactorizeDouble();
-  return factor_.info() == Eigen::Success;
+  return FactorizeDouble();
+}
+
+void CertificateMatrix::ReleaseFactor() {
+  double_->ReleaseNumericFactor();
+  double_factorized_ = false;
+  solver_.reset();
+}
+
+SparseCholeskyFactor CertificateMatrix::ExtractFactor() const {
+  CHECK(double_factorized_) << "ExtractFactor() without a factor";
+  return SparseCholeskyFactor(
+      ordering_, [this](const SparseCholeskyFactor::ColumnVisitor& column) {
+        double_->ForEachColumn(column);
+      });
 }
 
 bool CertificateMatrix::Prove(const Eigen::MatrixXd& Lambda, double c,
@@ -235,12 +266,11 @@ bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
     std::vector<double> rounding, rho;
     Assemble(Lambda, c, mu, &rounding);
     factorized_shift_ = mu;
-    FactorizeDouble();
-    if (factor_.info() != Eigen::Success) return false;
-    factor_.RowBackwardErrorBounds(&rho);
+    if (!FactorizeDouble()) return false;
+    double_->RowBackwardErrorBounds(&rho);
     double head = 0, tail = 0;
     for (int i = 0; i < static_cast<int>(rho.size()); ++i) {
-      const double bound = rho[i] + rounding[i] + data_rounding_[i];
+      const double bound = rho[position_[i]] + rounding[i] + data_rounding_[i];
       double& side = i < t0 ? head : tail;
       side = std::max(side, bound);
     }
@@ -259,14 +289,15 @@ bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
   return false;
 }
 
-void CertificateMatrix::InitializeDoubleDouble() {
+void CertificateMatrix::InitializePermutedPattern() {
   const int size = static_cast<int>(K_.rows());
   std::vector<int>& position = position_;  // Original index -> pivot order.
   position.resize(size);
   for (int k = 0; k < size; ++k) position[ordering_[k]] = k;
   // The permuted upper triangle: entry (r >= c) of K_ goes to column
   // max(position) and row min(position).
-  std::vector<int> start(size + 1, 0);
+  std::vector<int>& start = permuted_start_;
+  start.assign(size + 1, 0);
   const int* outer = K_.outerIndexPtr();
   const int* inner = K_.innerIndexPtr();
   for (int c = 0; c < size; ++c) {
@@ -275,20 +306,25 @@ void CertificateMatrix::InitializeDoubleDouble() {
     }
   }
   for (int k = 0; k < size; ++k) start[k + 1] += start[k];
-  std::vector<int> next(start.begin(), start.end() - 1), row(K_.nonZeros());
-  extended_index_.resize(K_.nonZeros());
+  std::vector<int> next(start.begin(), start.end() - 1);
+  permuted_row_.resize(K_.nonZeros());
+  permuted_index_.resize(K_.nonZeros());
   for (int c = 0; c < size; ++c) {
     for (int q = outer[c]; q < outer[c + 1]; ++q) {
       const int pr = position[inner[q]], pc = position[c];
       const int slot = next[std::max(pr, pc)]++;
-      row[slot] = std::min(pr, pc);
-      extended_index_[q] = slot;
+      permuted_row_[slot] = std::min(pr, pc);
+      permuted_index_[q] = slot;
     }
   }
+}
+
+void CertificateMatrix::InitializeDoubleDouble() {
   DoubleDoubleCholesky::Options options;
   options.num_threads = problem_.num_threads();
   extended_ = std::make_unique<DoubleDoubleCholesky>(options);
-  extended_->Analyze(size, std::move(start), std::move(row));
+  extended_->Analyze(static_cast<int>(K_.rows()), permuted_start_,
+                     permuted_row_);
 }
 
 bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
@@ -365,9 +401,9 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
     std::vector<double> assembly_abs(abs_sum);
     std::vector<int> assembly_count(count);
     for (int q = 0; q < K_.nonZeros(); ++q)
-      values[extended_index_[q]] = base[q];
+      values[permuted_index_[q]] = base[q];
     for (int j = 0; j < t0; ++j) {
-      DoubleDouble& v = values[extended_index_[translation_diagonal_[j]]];
+      DoubleDouble& v = values[permuted_index_[translation_diagonal_[j]]];
       v -= DoubleDouble(mu);
       assembly_abs[j] += mu;
       ++assembly_count[j];
@@ -376,7 +412,7 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
     for (int i = 0; i < n_; ++i) {
       for (int b = 0; b < d; ++b) {
         for (int a = b; a < d; ++a) {
-          DoubleDouble& v = values[extended_index_[block_entry_[k++]]];
+          DoubleDouble& v = values[permuted_index_[block_entry_[k++]]];
           const double lambda = Lambda(a, d * i + b);
           v -= DoubleDouble(lambda);
           if (a == b) v += DoubleDouble(c);
@@ -428,20 +464,22 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
   return false;
 }
 
-void CertificateMatrix::SolveShifted(const Eigen::VectorXd& y,
-                                     Eigen::VectorXd* x) const {
-  CHECK(factor_.HasNumericFactor()) << "SolveShifted() without a factor";
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(K_.rows());
-  rhs.tail(rotation_size_) = y;
-  *x = factor_.solve(rhs).tail(rotation_size_);
-}
-
 void CertificateMatrix::SolveShifted(const Eigen::MatrixXd& Y,
                                      Eigen::MatrixXd* X) const {
-  CHECK(factor_.HasNumericFactor()) << "SolveShifted() without a factor";
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(K_.rows(), Y.cols());
-  rhs.bottomRows(rotation_size_) = Y;
-  *X = factor_.solve(rhs).bottomRows(rotation_size_);
+  CHECK(double_factorized_) << "SolveShifted() without a factor";
+  if (!solver_)
+    solver_ = std::make_unique<SparseCholeskyFactor>(ExtractFactor());
+  Eigen::MatrixXd solution;
+  solver_->SolveRowsTail(Y.transpose(), translation_size_, &solution,
+                         problem_.num_threads());
+  *X = solution.transpose();
+}
+
+void CertificateMatrix::SolveShifted(const Eigen::VectorXd& y,
+                                     Eigen::VectorXd* x) const {
+  Eigen::MatrixXd solution;
+  SolveShifted(Eigen::MatrixXd(y), &solution);
+  *x = solution.col(0);
 }
 
 }  // namespace ceres_sesync::internal

@@ -12,6 +12,13 @@
 // factorization of K_c proves lambda_min(S) > -c, up to round-off, which
 // Prove() accounts for completely (see there). The same factorization (in
 // double) applies (S + cI)^{-1}, which the shift-and-invert eigensolver uses.
+//
+// Both arithmetics run the supernodal factorization of extended_cholesky.h
+// (threaded, in the problem's vertex ordering, symbolic analyses kept):
+// double for solves and fast proofs, double-double for proofs that double
+// cannot resolve. (CHOLMOD did the double ones before: at 10^5 poses its
+// serial factorization took 3.3x the time of this one on one thread, 5.9x
+// on two.)
 
 #ifndef CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
 #define CERES_SESYNC_INTERNAL_CERTIFICATE_MATRIX_H_
@@ -29,8 +36,8 @@ class DoubleDoubleCholesky;
 
 // The arithmetic of a proof's factorization.
 enum class ProofPrecision {
-  kDouble,        // CHOLMOD in double: fast; resolves ~1e-16 of K's scale.
-  kDoubleDouble,  // extended_cholesky.h: ~1e-31 of K's scale, 1-3.4x slower.
+  kDouble,        // Fast; resolves ~1e-16 of K's scale.
+  kDoubleDouble,  // ~1e-31 of K's scale, ~5x slower.
 };
 const char* ProofPrecisionName(ProofPrecision precision);
 
@@ -42,10 +49,11 @@ class CertificateMatrix {
   ~CertificateMatrix();
 
   // After problem.UpdateWeights(): copies the new base values and rounding
-  // bounds. The pattern is the same, so the symbolic analyses (CHOLMOD's and
-  // the double-double one) are kept; the next factorization is numeric
-  // only. The double-double proofs assemble from ForEachDataTerm with the
-  // problem's weights, so they are of the weighted problem too.
+  // bounds. The pattern is the same, so the symbolic analyses (of the
+  // double and the double-double factorization) are kept; the next
+  // factorization is numeric only. The double-double proofs assemble from
+  // ForEachDataTerm with the problem's weights, so they are of the weighted
+  // problem too.
   void Refresh();
 
   // Factorizes K_c in double for solves (the preconditioner, the
@@ -60,8 +68,8 @@ class CertificateMatrix {
   // the measurements' exact values and mu > 0 a shift of the translation
   // block. A completed factorization L L^T = K'~ + E of the assembled K'~
   // bounds, row by row, the factorization's backward error E
-  // (CholmodFactor::RowBackwardErrorBounds or DoubleDoubleCholesky's, both
-  // gamma_{k+1} |L||L^T|) and the assembly's rounding A = K'~ - K':
+  // (DoubleDoubleCholesky::RowBackwardErrorBounds, gamma_{k+1} |L||L^T| in
+  // either arithmetic) and the assembly's rounding A = K'~ - K':
   // K' + diag(rho) >= 0 with rho_i >= sum_j |E_ij| + |A_ij|. If rho_i <= mu on
   // every translation row, then K_c + diag(0, delta I) >= 0 with delta the
   // largest rho_i on the rotation rows, and its Schur complement gives
@@ -76,17 +84,17 @@ class CertificateMatrix {
   // Frees the double factor (after ExtractFactor(), its copy is all that a
   // caller needs) and keeps the symbolic analysis. SolveShifted() needs a
   // new Factorize() or double Prove() after this.
-  void ReleaseFactor() { factor_.ReleaseNumericFactor(); }
+  void ReleaseFactor();
 
   // After a successful Factorize() or double Prove(): x = (S_mu + cI)^{-1} y,
   // y and x in R^{dn}, with mu = translation_shift() (0 after Factorize()).
   void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;
   // The same for the columns of Y (dn x k).
   void SolveShifted(const Eigen::MatrixXd& Y, Eigen::MatrixXd* X) const;
-  // After a successful Factorize(): a copy of the factor for fast repeated
-  // solves X = V (S + cI)^{-1} with V of size r x dn (SolveRowsTail with
-  // offset translation_size()).
-  SparseCholeskyFactor ExtractFactor() { return factor_.ExtractFactor(); }
+  // After a successful Factorize() (or double Prove()): a copy of the factor
+  // for fast repeated solves X = V (S + cI)^{-1} with V of size r x dn
+  // (SolveRowsTail with offset translation_size()).
+  SparseCholeskyFactor ExtractFactor() const;
   int translation_size() const { return translation_size_; }
 
   // After a successful Prove(): eta = c + delta, delta and mu.
@@ -99,8 +107,9 @@ class CertificateMatrix {
 
   // A time limit for the factorizations (none by default): a double-double
   // factorization stops when it passes (Prove() then returns false and
-  // timed_out() is true); CHOLMOD's cannot be interrupted, so callers ask
-  // PredictedSeconds() first.
+  // timed_out() is true); double ones run to the end (a stopped one would
+  // read as "not positive definite" to callers of Factorize()), so callers
+  // ask PredictedSeconds() first.
   void set_deadline(std::chrono::steady_clock::time_point deadline) {
     deadline_ = deadline;
   }
@@ -123,12 +132,10 @@ class CertificateMatrix {
 
   // A factorization's cost in units of the two triangular solves with r
   // right-hand sides that one preconditioned Hessian-vector product applies
-  // with a factor of K's pattern: flops / (4 r nnz(L)), CHOLMOD's symbolic
-  // prediction (deterministic, unlike a measured time).
-  double FactorizationCostInSolves(int r) const {
-    return factor_.analysis_flops() /
-           (4.0 * r * std::max(1.0, factor_.analysis_nonzeros()));
-  }
+  // with a factor of K's pattern: flops / (4 r nnz(L)) with two flops per
+  // multiply-add, from the symbolic analysis (deterministic, unlike a
+  // measured time).
+  double FactorizationCostInSolves(int r) const;
 
   // The double-double proofs' symbolic analysis (permuted pattern, elimination
   // tree, supernodes), which the first of them runs otherwise; for running
@@ -140,9 +147,10 @@ class CertificateMatrix {
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }
-  // CHOLMOD chose a supernodal factor: factorizations cost much more than
-  // products with Q (3D graphs).
-  bool supernodal() const { return factor_.IsSupernodal(); }
+  // Factorizations cost much more than products with Q (3D graphs): flops /
+  // nnz(L) >= kSupernodalSwitch, the rule by which CHOLMOD would choose its
+  // supernodal layout here.
+  bool supernodal() const;
 
  private:
   // K's pattern with the problem's current base values.
@@ -154,10 +162,13 @@ class CertificateMatrix {
   void Assemble(const Eigen::MatrixXd& Lambda, double c, double mu,
                 std::vector<double>* rounding);
   bool ProveDouble(const Eigen::MatrixXd& Lambda, double c);
-  // factor_.factorize(K_), counted and timed.
-  void FactorizeDouble();
+  // The double factorization of K_, counted and timed; true iff it completed.
+  bool FactorizeDouble();
   bool ProveDoubleDouble(const Eigen::MatrixXd& Lambda, double c);
-  // The permuted pattern and symbolic analysis of the double-double factor.
+  // K_'s upper triangle permuted by ordering_ (permuted_start_,
+  // permuted_row_), the map of its values (permuted_index_) and position_.
+  void InitializePermutedPattern();
+  // The symbolic analysis of the double-double factor.
   void InitializeDoubleDouble();
   // mu settled when the translation rows' bound `head` met it or not.
   bool SettleShift(double head, double* mu) const;
@@ -169,10 +180,18 @@ class CertificateMatrix {
   std::vector<int> block_entry_;           // Value index of each (i, a >= b).
   std::vector<int> translation_diagonal_;  // Value index of each Lbar_jj.
   std::vector<int> ordering_;  // Fill-reducing: ordering_[k] = k-th pivot.
-  std::vector<int> position_;  // Its inverse (after InitializeDoubleDouble).
+  std::vector<int> position_;  // Its inverse.
+  // The permuted upper triangle of K_ in compressed columns, and where each
+  // value of K_ goes in it.
+  std::vector<int> permuted_start_, permuted_row_, permuted_index_;
   // Rounding of the stored data matrices, per row of K.
   std::vector<double> data_rounding_;
-  CholmodFactor factor_;
+  // The double factorizations (same scheme as the double-double proofs,
+  // extended_cholesky.h) and, built on the first SolveShifted() after one,
+  // the solver of its factor.
+  std::unique_ptr<DoubleDoubleCholesky> double_;
+  bool double_factorized_ = false;
+  mutable std::unique_ptr<SparseCholeskyFactor> solver_;
   double factorized_shift_ = 0;  // mu of the current double factor.
   // mu per precision: the translation block of a proof's matrix is Lbar - mu I.
   double double_shift_ = 0, extended_shift_ = 0;
@@ -185,10 +204,8 @@ class CertificateMatrix {
   std::chrono::steady_clock::time_point deadline_ =
       std::chrono::steady_clock::time_point::max();
   bool timed_out_ = false;
-  // Double-double: the factorization, the map from K_'s value indices to its
-  // permuted upper-triangle values, and those values.
+  // Double-double: the factorization.
   std::unique_ptr<DoubleDoubleCholesky> extended_;
-  std::vector<int> extended_index_;
 };
 
 }  // namespace ceres_sesync::internal

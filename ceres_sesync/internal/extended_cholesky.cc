@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -29,6 +30,7 @@ namespace {
 constexpr double kSmallestSafeValue = 0x1p-900;
 constexpr double kLargestSafeValue = 0x1p900;
 constexpr double kUnderflowError = 0x1p-1070;
+constexpr double kUnitRoundoff = 0x1p-53;  // Of double.
 
 bool Safe(const DoubleDouble& x) {
   const double a = std::abs(x.hi);
@@ -95,6 +97,9 @@ __attribute__((target_clones("fma", "default"))) bool FactorizeRows(
 }
 
 // ---- Dense kernels of the supernodal factorization ------------------------
+//
+// In double the kernels are the same loops with one FMA per product and no
+// low parts (Tile below), and a pivot's column is divided by it.
 //
 // Double-double matrices are stored as two column-major arrays of doubles
 // (high and low parts) with a common leading dimension, so that W
@@ -234,12 +239,61 @@ template <class Lanes, int kRows, int kColumns>
   }
 }
 
+// The same in double: C(i, j) <- C(i, j) - A(i, l) B(j, l) for l = 0 ..
+// count - 1 in order, one FMA (a single rounding) per product.
+template <class Lanes, int kRows, int kColumns>
+[[gnu::always_inline]] inline void UpdateTileDouble(const double* a, int lda,
+                                                    const double* b, int ldb,
+                                                    double* c, int ldc,
+                                                    int count) {
+  using Real = typename Lanes::Real;
+  constexpr int W = Lanes::kWidth;
+  Real T[kRows][kColumns];
+#pragma GCC unroll 4
+  for (int j = 0; j < kColumns; ++j) {
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) T[r][j] = Lanes::Load(c + r * W + j * ldc);
+  }
+  for (int l = 0; l < count; ++l) {
+    Real x[kRows];
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) x[r] = Lanes::Load(a + l * lda + r * W);
+#pragma GCC unroll 4
+    for (int j = 0; j < kColumns; ++j) {
+      const Real y = -Lanes::Broadcast(b + l * ldb + j);
+#pragma GCC unroll 4
+      for (int r = 0; r < kRows; ++r) T[r][j] = Lanes::Fma(x[r], y, T[r][j]);
+    }
+  }
+#pragma GCC unroll 4
+  for (int j = 0; j < kColumns; ++j) {
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) Lanes::Store(c + r * W + j * ldc, T[r][j]);
+  }
+}
+
+// One tile in either arithmetic (the low parts are unused in double).
+template <class Lanes, bool kExtended, int kRows, int kColumns>
+[[gnu::always_inline]] inline void Tile(const double* a_hi, const double* a_lo,
+                                        int lda, const double* b_hi,
+                                        const double* b_lo, int ldb,
+                                        double* c_hi, double* c_lo, int ldc,
+                                        int count) {
+  if constexpr (kExtended) {
+    UpdateTile<Lanes, kRows, kColumns>(a_hi, a_lo, lda, b_hi, b_lo, ldb, c_hi,
+                                       c_lo, ldc, count);
+  } else {
+    UpdateTileDouble<Lanes, kRows, kColumns>(a_hi, lda, b_hi, ldb, c_hi, ldc,
+                                             count);
+  }
+}
+
 // Columns j0 .. j0 + kColumns - 1, rows [max(j0, i0), i1), l in [l0, l1):
 // tiles of kRows vectors (several independent accumulators per column hide
 // the latency of each one's chain), then single vectors; the last rows
 // (fewer than W) are copied into zero-padded buffers for one more vector
 // tile (lanes are independent: the same operations as on their own).
-template <class Lanes, int kColumns>
+template <class Lanes, bool kExtended, int kColumns>
 [[gnu::always_inline]] inline void UpdateColumns(const UpdateBlock& u, int j0,
                                                  int i0, int i1, int l0,
                                                  int l1) {
@@ -247,30 +301,33 @@ template <class Lanes, int kColumns>
   constexpr int kRows = kColumns >= 3 ? 2 : 4;
   const int count = l1 - l0;
   const long long a0 = static_cast<long long>(l0) * u.lda;
-  const double* b_hi = u.b_hi + static_cast<long long>(l0) * u.ldb + j0;
-  const double* b_lo = u.b_lo + static_cast<long long>(l0) * u.ldb + j0;
+  const long long b0 = static_cast<long long>(l0) * u.ldb + j0;
+  const double* b_hi = u.b_hi + b0;
+  const double* b_lo = kExtended ? u.b_lo + b0 : nullptr;
   const long long c0 = static_cast<long long>(j0) * u.ldc;
+  // The low parts at offset `at` (none in double).
+  auto lo = [](auto* p, long long at) { return kExtended ? p + at : nullptr; };
   int i = std::max(i0, j0);
   for (; i + kRows * W <= i1; i += kRows * W) {
-    UpdateTile<Lanes, kRows, kColumns>(u.a_hi + a0 + i, u.a_lo + a0 + i, u.lda,
-                                       b_hi, b_lo, u.ldb, u.c_hi + c0 + i,
-                                       u.c_lo + c0 + i, u.ldc, count);
+    Tile<Lanes, kExtended, kRows, kColumns>(
+        u.a_hi + a0 + i, lo(u.a_lo, a0 + i), u.lda, b_hi, b_lo, u.ldb,
+        u.c_hi + c0 + i, lo(u.c_lo, c0 + i), u.ldc, count);
   }
   for (; i + W <= i1; i += W) {
-    UpdateTile<Lanes, 1, kColumns>(u.a_hi + a0 + i, u.a_lo + a0 + i, u.lda,
-                                   b_hi, b_lo, u.ldb, u.c_hi + c0 + i,
-                                   u.c_lo + c0 + i, u.ldc, count);
+    Tile<Lanes, kExtended, 1, kColumns>(
+        u.a_hi + a0 + i, lo(u.a_lo, a0 + i), u.lda, b_hi, b_lo, u.ldb,
+        u.c_hi + c0 + i, lo(u.c_lo, c0 + i), u.ldc, count);
   }
   const int rest = i1 - i;
   if (rest > 0) {
-    double pa_hi[kInnerChunk * W], pa_lo[kInnerChunk * W];
-    double pc_hi[kColumns * W], pc_lo[kColumns * W];
+    double pa_hi[kInnerChunk * W], pa_lo[kExtended ? kInnerChunk * W : 1];
+    double pc_hi[kColumns * W], pc_lo[kExtended ? kColumns * W : 1];
     for (int l = 0; l < count; ++l) {
       for (int r = 0; r < W; ++r) {
         const bool in = r < rest;
         const long long q = a0 + static_cast<long long>(l) * u.lda + i + r;
         pa_hi[l * W + r] = in ? u.a_hi[q] : 0;
-        pa_lo[l * W + r] = in ? u.a_lo[q] : 0;
+        if constexpr (kExtended) pa_lo[l * W + r] = in ? u.a_lo[q] : 0;
       }
     }
     for (int c = 0; c < kColumns; ++c) {
@@ -278,22 +335,22 @@ template <class Lanes, int kColumns>
         const bool in = r < rest;
         const long long q = c0 + static_cast<long long>(c) * u.ldc + i + r;
         pc_hi[c * W + r] = in ? u.c_hi[q] : 0;
-        pc_lo[c * W + r] = in ? u.c_lo[q] : 0;
+        if constexpr (kExtended) pc_lo[c * W + r] = in ? u.c_lo[q] : 0;
       }
     }
-    UpdateTile<Lanes, 1, kColumns>(pa_hi, pa_lo, W, b_hi, b_lo, u.ldb, pc_hi,
-                                   pc_lo, W, count);
+    Tile<Lanes, kExtended, 1, kColumns>(pa_hi, pa_lo, W, b_hi, b_lo, u.ldb,
+                                        pc_hi, pc_lo, W, count);
     for (int c = 0; c < kColumns; ++c) {
       for (int r = 0; r < rest; ++r) {
         const long long q = c0 + static_cast<long long>(c) * u.ldc + i + r;
         u.c_hi[q] = pc_hi[c * W + r];
-        u.c_lo[q] = pc_lo[c * W + r];
+        if constexpr (kExtended) u.c_lo[q] = pc_lo[c * W + r];
       }
     }
   }
 }
 
-template <class Lanes>
+template <class Lanes, bool kExtended>
 [[gnu::always_inline]] inline void Update(const UpdateBlock& u) {
   for (int l0 = 0; l0 < u.k; l0 += kInnerChunk) {
     const int l1 = std::min(u.k, l0 + kInnerChunk);
@@ -302,16 +359,16 @@ template <class Lanes>
       for (int j0 = 0; j0 < std::min(u.n, i1); j0 += kColumnBlock) {
         switch (std::min(kColumnBlock, u.n - j0)) {
           case 4:
-            UpdateColumns<Lanes, 4>(u, j0, i0, i1, l0, l1);
+            UpdateColumns<Lanes, kExtended, 4>(u, j0, i0, i1, l0, l1);
             break;
           case 3:
-            UpdateColumns<Lanes, 3>(u, j0, i0, i1, l0, l1);
+            UpdateColumns<Lanes, kExtended, 3>(u, j0, i0, i1, l0, l1);
             break;
           case 2:
-            UpdateColumns<Lanes, 2>(u, j0, i0, i1, l0, l1);
+            UpdateColumns<Lanes, kExtended, 2>(u, j0, i0, i1, l0, l1);
             break;
           default:
-            UpdateColumns<Lanes, 1>(u, j0, i0, i1, l0, l1);
+            UpdateColumns<Lanes, kExtended, 1>(u, j0, i0, i1, l0, l1);
         }
       }
     }
@@ -339,7 +396,23 @@ template <class Lanes>
   }
 }
 
-void UpdatePortable(const UpdateBlock& u) { Update<ScalarLanes>(u); }
+// x(i) <- x(i) / y for i < m (double, correctly rounded).
+template <class Lanes>
+[[gnu::always_inline]] inline void Divide(int m, double* x, double y) {
+  constexpr int W = Lanes::kWidth;
+  const typename Lanes::Real v = Lanes::Broadcast(&y);
+  int i = 0;
+  for (; i + W <= m; i += W) Lanes::Store(x + i, Lanes::Load(x + i) / v);
+  for (; i < m; ++i) x[i] /= y;
+}
+
+void UpdatePortable(const UpdateBlock& u) { Update<ScalarLanes, true>(u); }
+void UpdateDoublePortable(const UpdateBlock& u) {
+  Update<ScalarLanes, false>(u);
+}
+void DividePortable(int m, double* x, double y) {
+  Divide<ScalarLanes>(m, x, y);
+}
 void ScalePortable(int m, double* x_hi, double* x_lo, double y_hi,
                    double y_lo) {
   Scale<ScalarLanes>(m, x_hi, x_lo, y_hi, y_lo);
@@ -347,7 +420,15 @@ void ScalePortable(int m, double* x_hi, double* x_lo, double y_hi,
 
 #if defined(__x86_64__) || defined(__i386__)
 __attribute__((target("avx2,fma"))) void UpdateAvx2(const UpdateBlock& u) {
-  Update<Lanes4>(u);
+  Update<Lanes4, true>(u);
+}
+__attribute__((target("avx2,fma"))) void UpdateDoubleAvx2(
+    const UpdateBlock& u) {
+  Update<Lanes4, false>(u);
+}
+__attribute__((target("avx2,fma"))) void DivideAvx2(int m, double* x,
+                                                    double y) {
+  Divide<Lanes4>(m, x, y);
 }
 __attribute__((target("avx2,fma"))) void ScaleAvx2(int m, double* x_hi,
                                                    double* x_lo, double y_hi,
@@ -359,6 +440,8 @@ bool HaveAvx2() {
 }
 #else
 void UpdateAvx2(const UpdateBlock& u) { UpdatePortable(u); }
+void UpdateDoubleAvx2(const UpdateBlock& u) { UpdateDoublePortable(u); }
+void DivideAvx2(int m, double* x, double y) { DividePortable(m, x, y); }
 void ScaleAvx2(int m, double* x_hi, double* x_lo, double y_hi, double y_lo) {
   ScalePortable(m, x_hi, x_lo, y_hi, y_lo);
 }
@@ -369,6 +452,8 @@ bool HaveAvx2() { return false; }
 struct Kernels {
   void (*update)(const UpdateBlock&);
   void (*scale)(int m, double* x_hi, double* x_lo, double y_hi, double y_lo);
+  void (*update_double)(const UpdateBlock&);  // Only the high parts.
+  void (*divide)(int m, double* x, double y);
 };
 
 // Factors one supernode in place after all updates from below: its nrows x
@@ -384,36 +469,49 @@ constexpr int kPanel = 32;
 // ranges on several threads (the top separators of nested dissection).
 constexpr int kMinColumnSplit = 64;
 
+template <bool kExtended>
 bool FactorSupernode(const Kernels& kernels, int nrows, int ncols, double* hi,
                      double* lo) {
   const int ld = nrows;
-  // Entry (i, j) of the block.
+  // Entry (i, j) of the block (no low parts in double).
   auto at = [ld](double* x, int i, int j) {
+    return kExtended ? x + i + static_cast<long long>(j) * ld : nullptr;
+  };
+  auto at_hi = [ld](double* x, int i, int j) {
     return x + i + static_cast<long long>(j) * ld;
   };
+  const auto update = kExtended ? kernels.update : kernels.update_double;
   for (int c0 = 0; c0 < ncols; c0 += kPanel) {
     const int c1 = std::min(ncols, c0 + kPanel);
     if (c0 > 0) {
-      kernels.update({hi + c0, lo + c0, ld, hi + c0, lo + c0, ld,
-                      at(hi, c0, c0), at(lo, c0, c0), ld, nrows - c0, c1 - c0,
-                      c0});
+      update({hi + c0, at(lo, c0, 0), ld, hi + c0, at(lo, c0, 0), ld,
+              at_hi(hi, c0, c0), at(lo, c0, c0), ld, nrows - c0, c1 - c0, c0});
     }
     for (int j = c0; j < c1; ++j) {
-      double* x_hi = at(hi, 0, j);
-      double* x_lo = at(lo, 0, j);
+      double* x_hi = at_hi(hi, 0, j);
       if (j > c0) {
-        kernels.update({at(hi, j, c0), at(lo, j, c0), ld, at(hi, j, c0),
-                        at(lo, j, c0), ld, x_hi + j, x_lo + j, ld, nrows - j, 1,
-                        j - c0});
+        update({at_hi(hi, j, c0), at(lo, j, c0), ld, at_hi(hi, j, c0),
+                at(lo, j, c0), ld, x_hi + j, at(lo, j, j), ld, nrows - j, 1,
+                j - c0});
       }
-      const DoubleDouble d(x_hi[j], x_lo[j]);
-      if (!(d.hi > 0) || !Safe(d)) return false;
-      const DoubleDouble l_jj = Sqrt(d);
-      const DoubleDouble inverse = Reciprocal(l_jj);
-      x_hi[j] = l_jj.hi;
-      x_lo[j] = l_jj.lo;
-      kernels.scale(nrows - j - 1, x_hi + j + 1, x_lo + j + 1, inverse.hi,
-                    inverse.lo);
+      if constexpr (kExtended) {
+        double* x_lo = at(lo, 0, j);
+        const DoubleDouble d(x_hi[j], x_lo[j]);
+        if (!(d.hi > 0) || !Safe(d)) return false;
+        const DoubleDouble l_jj = Sqrt(d);
+        const DoubleDouble inverse = Reciprocal(l_jj);
+        x_hi[j] = l_jj.hi;
+        x_lo[j] = l_jj.lo;
+        kernels.scale(nrows - j - 1, x_hi + j + 1, x_lo + j + 1, inverse.hi,
+                      inverse.lo);
+      } else {
+        // Higham's Algorithm 10.2 step for step: l_jj = sqrt(d), then
+        // l_ij = (a_ij - sum) / l_jj, each correctly rounded.
+        const double d = x_hi[j];
+        if (!(d > 0) || !Safe(DoubleDouble(d))) return false;
+        x_hi[j] = std::sqrt(d);
+        kernels.divide(nrows - j - 1, x_hi + j + 1, x_hi[j]);
+      }
     }
   }
   return true;
@@ -634,12 +732,17 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
   }
 }
 
+template <typename Value>
 bool DoubleDoubleCholesky::FactorizeSupernodal(
-    const std::vector<DoubleDouble>& values,
+    const std::vector<Value>& values,
     std::chrono::steady_clock::time_point deadline) {
+  constexpr bool kExtended = std::is_same_v<Value, DoubleDouble>;
   const int num_super = num_supernodes();
-  const Kernels kernels = vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2}
-                                      : Kernels{UpdatePortable, ScalePortable};
+  const Kernels kernels =
+      vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2, UpdateDoubleAvx2, DivideAvx2}
+                  : Kernels{UpdatePortable, ScalePortable, UpdateDoublePortable,
+                            DividePortable};
+  const auto update_kernel = kExtended ? kernels.update : kernels.update_double;
   // The dense blocks, kept as the factor: allocated once per analysis and
   // left unwritten here. Each column is zeroed and filled with its values
   // by the thread that factors it (fill_columns below), so that the first
@@ -651,10 +754,14 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   const size_t entries = static_cast<size_t>(supernodal_entries());
   if (super_hi.size() != entries) {
     HugePageVector<double>().swap(super_hi);
-    HugePageVector<double>().swap(super_lo);
     super_hi.resize(entries);  // Default-initialized: not written.
-    super_lo.resize(entries);
   }
+  if (super_lo.size() != (kExtended ? entries : 0)) {
+    HugePageVector<double>().swap(super_lo);
+    super_lo.resize(kExtended ? entries : 0);
+  }
+  // The low parts at offset `at` (none in double).
+  auto lo = [](auto* p, long long at) { return kExtended ? p + at : nullptr; };
   // Zeros columns c0 .. c1 - 1 of supernode s (nrows rows, values s_hi and
   // s_lo) and scatters A's values into them.
   auto fill_columns = [&](int s, int c0, int c1, int nrows, double* s_hi,
@@ -662,15 +769,21 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     const int first = super_start_[s];
     std::fill(s_hi + static_cast<long long>(c0) * nrows,
               s_hi + static_cast<long long>(c1) * nrows, 0.0);
-    std::fill(s_lo + static_cast<long long>(c0) * nrows,
-              s_lo + static_cast<long long>(c1) * nrows, 0.0);
+    if constexpr (kExtended) {
+      std::fill(s_lo + static_cast<long long>(c0) * nrows,
+                s_lo + static_cast<long long>(c1) * nrows, 0.0);
+    }
     for (int q = scatter_start_[first + c0]; q < scatter_start_[first + c1];
          ++q) {
-      // Renormalized (the same value): the kernels' bounds assume it.
-      const DoubleDouble& value = values[scatter_source_[q]];
-      const DoubleDouble v = dd::TwoSum(value.hi, value.lo);
-      super_hi[scatter_destination_[q]] = v.hi;
-      super_lo[scatter_destination_[q]] = v.lo;
+      if constexpr (kExtended) {
+        // Renormalized (the same value): the kernels' bounds assume it.
+        const DoubleDouble& value = values[scatter_source_[q]];
+        const DoubleDouble v = dd::TwoSum(value.hi, value.lo);
+        super_hi[scatter_destination_[q]] = v.hi;
+        super_lo[scatter_destination_[q]] = v.lo;
+      } else {
+        super_hi[scatter_destination_[q]] = values[scatter_source_[q]];
+      }
     }
   };
   // Left-looking: supernode d, once factored, waits in the list of the
@@ -702,17 +815,16 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     const int* d_rows = super_row_.data() + super_row_start_[d];
     const int m = d_nrows - p1, n = p2 - p1;
     const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
-    const double* d_lo = super_lo.data() + super_value_start_[d] + p1;
+    const double* d_lo = lo(super_lo.data(), super_value_start_[d] + p1);
     const int k = super_start_[d + 1] - super_start_[d];
     // The target rows of d's rows p1.. are contiguous in s (positions
     // increase with the rows): update s in place; otherwise gather the
     // target entries, update, scatter.
     const int r0 = position[d_rows[p1]];
     if (position[d_rows[d_nrows - 1]] - r0 == m - 1) {
-      kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows,
-                      s_hi + r0 + static_cast<long long>(r0) * nrows,
-                      s_lo + r0 + static_cast<long long>(r0) * nrows, nrows, m,
-                      n, k});
+      const long long at = r0 + static_cast<long long>(r0) * nrows;
+      update_kernel({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows, s_hi + at,
+                     lo(s_lo, at), nrows, m, n, k});
       return;
     }
     std::vector<int>& relative = scratch->relative;
@@ -721,33 +833,34 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     relative.resize(m);
     for (int i = 0; i < m; ++i) relative[i] = position[d_rows[p1 + i]];
     const size_t size = static_cast<size_t>(m) * n;
-    if (work_hi.size() < size) {
-      work_hi.resize(size);
-      work_lo.resize(size);
-    }
+    if (work_hi.size() < size) work_hi.resize(size);
+    if (kExtended && work_lo.size() < size) work_lo.resize(size);
     for (int j = 0; j < n; ++j) {
-      const double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
-      const double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
+      const long long t = static_cast<long long>(relative[j]) * nrows;
+      const double* t_hi = s_hi + t;
       double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
-      double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
       // Zeros above the diagonal where the kernel computes unused entries
       // (from the start of j's block of columns).
-      for (int i = j - j % kColumnBlock; i < j; ++i) w_hi[i] = w_lo[i] = 0;
-      for (int i = j; i < m; ++i) {
-        w_hi[i] = t_hi[relative[i]];
-        w_lo[i] = t_lo[relative[i]];
+      for (int i = j - j % kColumnBlock; i < j; ++i) w_hi[i] = 0;
+      for (int i = j; i < m; ++i) w_hi[i] = t_hi[relative[i]];
+      if constexpr (kExtended) {
+        const double* t_lo = s_lo + t;
+        double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+        for (int i = j - j % kColumnBlock; i < j; ++i) w_lo[i] = 0;
+        for (int i = j; i < m; ++i) w_lo[i] = t_lo[relative[i]];
       }
     }
-    kernels.update({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows, work_hi.data(),
-                    work_lo.data(), m, m, n, k});
+    update_kernel({d_hi, d_lo, d_nrows, d_hi, d_lo, d_nrows, work_hi.data(),
+                   lo(work_lo.data(), 0), m, m, n, k});
     for (int j = 0; j < n; ++j) {
-      double* t_hi = s_hi + static_cast<long long>(relative[j]) * nrows;
-      double* t_lo = s_lo + static_cast<long long>(relative[j]) * nrows;
+      const long long t = static_cast<long long>(relative[j]) * nrows;
+      double* t_hi = s_hi + t;
       const double* w_hi = work_hi.data() + static_cast<size_t>(j) * m;
-      const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
-      for (int i = j; i < m; ++i) {
-        t_hi[relative[i]] = w_hi[i];
-        t_lo[relative[i]] = w_lo[i];
+      for (int i = j; i < m; ++i) t_hi[relative[i]] = w_hi[i];
+      if constexpr (kExtended) {
+        double* t_lo = s_lo + t;
+        const double* w_lo = work_lo.data() + static_cast<size_t>(j) * m;
+        for (int i = j; i < m; ++i) t_lo[relative[i]] = w_lo[i];
       }
     }
   };
@@ -773,7 +886,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       const int nrows = super_row_start_[s + 1] - super_row_start_[s];
       const int* rows = super_row_.data() + super_row_start_[s];
       double* s_hi = super_hi.data() + super_value_start_[s];
-      double* s_lo = super_lo.data() + super_value_start_[s];
+      double* s_lo = lo(super_lo.data(), super_value_start_[s]);
       for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
       // The updates: supernode d's rows p1 = pointer[d] .. p2 - 1 are in
       // s's columns.
@@ -826,7 +939,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
           head[target] = d;
         }
       }
-      if (!FactorSupernode(kernels, nrows, ncols, s_hi, s_lo)) {
+      if (!FactorSupernode<kExtended>(kernels, nrows, ncols, s_hi, s_lo)) {
         stop = true;
         return false;
       }
@@ -871,10 +984,33 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
 }
 
 bool DoubleDoubleCholesky::Factorize(
+    const std::vector<double>& values,
+    std::chrono::steady_clock::time_point deadline) {
+  CHECK(options_.supernodal) << "double: the supernodal scheme only";
+  CHECK_EQ(values.size(), row_index_.size());
+  timed_out_ = false;
+  extended_factor_ = false;
+  factor_value_.clear();
+  for (double v : values) {
+    if (!Safe(DoubleDouble(v))) return factorized_ = false;
+  }
+  factorized_ = FactorizeSupernodal(values, deadline);
+  return factorized_;
+}
+
+void DoubleDoubleCholesky::ReleaseNumericFactor() {
+  HugePageVector<double>().swap(super_hi_);
+  HugePageVector<double>().swap(super_lo_);
+  std::vector<DoubleDouble>().swap(factor_value_);
+  factorized_ = false;
+}
+
+bool DoubleDoubleCholesky::Factorize(
     const std::vector<DoubleDouble>& values,
     std::chrono::steady_clock::time_point deadline) {
   CHECK_EQ(values.size(), row_index_.size());
   timed_out_ = false;
+  extended_factor_ = true;
   for (const DoubleDouble& v : values) {
     if (!Safe(v)) return factorized_ = false;
   }
@@ -923,8 +1059,11 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
   for (int i = 0; i < n_; ++i) {
     const double entries =
         row_count_[i] + (factor_start_[i + 1] - factor_start_[i]);
-    (*rho)[i] = DoubleDoubleGamma(row_count_[i] + 1) * v[i] * (1 + 1e-6) +
-                entries * underflow_per_entry;
+    const double m = row_count_[i] + 1;
+    const double gamma = extended_factor_
+                             ? DoubleDoubleGamma(m)
+                             : m * kUnitRoundoff / (1 - m * kUnitRoundoff);
+    (*rho)[i] = gamma * v[i] * (1 + 1e-6) + entries * underflow_per_entry;
   }
 }
 
@@ -952,6 +1091,28 @@ const std::vector<DoubleDouble>& DoubleDoubleCholesky::factor_value() const {
     }
   }
   return factor_value_;
+}
+
+void DoubleDoubleCholesky::ForEachColumn(
+    const std::function<void(int, double, std::vector<int>*,
+                             std::vector<double>*)>& f) const {
+  CHECK(factorized_);
+  std::vector<int> rows;
+  std::vector<double> values;
+  for (int c = 0; c < n_; ++c) {
+    rows.clear();
+    values.clear();
+    double diagonal = 0;
+    ForEachEntry(c, [&](int row, const DoubleDouble& l) {
+      if (row == c) {
+        diagonal = l.hi;
+      } else {
+        rows.push_back(row);
+        values.push_back(l.hi);
+      }
+    });
+    f(c, diagonal, &rows, &values);
+  }
 }
 
 }  // namespace ceres_sesync::internal

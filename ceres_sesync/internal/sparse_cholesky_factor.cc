@@ -72,11 +72,26 @@ SparseCholeskyFactor::SparseCholeskyFactor(const cholmod_factor* factor,
         << "cholmod_change_factor failed";
     L = converted;
   }
-  n_ = static_cast<int>(L->n);
+  const int n = static_cast<int>(L->n);
   const int* perm = static_cast<const int*>(L->Perm);
-  permutation_.resize(n_);
-  for (int j = 0; j < n_; ++j) permutation_[j] = perm != nullptr ? perm[j] : j;
+  std::vector<int> permutation(n);
+  for (int j = 0; j < n; ++j) permutation[j] = perm != nullptr ? perm[j] : j;
+  Build(std::move(permutation),
+        [L](const ColumnVisitor& column) { ForEachColumn(*L, column); });
+  if (converted != nullptr) cholmod_free_factor(&converted, common);
+}
 
+SparseCholeskyFactor::SparseCholeskyFactor(
+    std::vector<int> permutation,
+    const std::function<void(const ColumnVisitor&)>& for_each_column) {
+  Build(std::move(permutation), for_each_column);
+}
+
+void SparseCholeskyFactor::Build(
+    std::vector<int> permutation,
+    const std::function<void(const ColumnVisitor&)>& for_each_column) {
+  n_ = static_cast<int>(permutation.size());
+  permutation_ = std::move(permutation);
   // Two passes over L: the first counts what the second stores (so the
   // arrays are allocated once, at their final size).
   int64_t num_values = 0, num_rows = 0, num_supernodes = 0;
@@ -125,8 +140,8 @@ SparseCholeskyFactor::SparseCholeskyFactor(const cholmod_factor* factor,
       columns.clear();
       diagonal.clear();
     };
-    ForEachColumn(*L, [&](int j, double diag, std::vector<int>* rows,
-                          std::vector<double>* values) {
+    for_each_column([&](int j, double diag, std::vector<int>* rows,
+                        std::vector<double>* values) {
       // Sort by row (CHOLMOD's columns are sorted already; cheap to check),
       // then drop exact zeros: structural zeros of relaxed supernodes.
       if (!std::is_sorted(rows->begin(), rows->end())) {
@@ -172,7 +187,6 @@ SparseCholeskyFactor::SparseCholeskyFactor(const cholmod_factor* factor,
     flush();
   }
   first_.push_back(n_);
-  if (converted != nullptr) cholmod_free_factor(&converted, common);
   BuildSchedule();
 }
 

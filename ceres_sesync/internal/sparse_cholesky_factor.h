@@ -1,4 +1,5 @@
-// A sparse Cholesky factor P A P^T = L L^T, extracted once from CHOLMOD, with
+// A sparse Cholesky factor P A P^T = L L^T, copied once from CHOLMOD's or
+// extended_cholesky.h's (in double), with
 // triangular solves specialized for the SE-Sync data layout: the right-hand
 // side is an r x N matrix whose N columns are the (vector-valued) unknowns, so
 // X = B A^{-1} is solved in one pass over L with contiguous r-vector updates.
@@ -39,6 +40,7 @@
 #define CERES_SESYNC_INTERNAL_SPARSE_CHOLESKY_FACTOR_H_
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "Eigen/Core"
@@ -53,6 +55,15 @@ class SparseCholeskyFactor {
   // P A P^T; `factor` is unchanged. Reads a supernodal or simplicial LL^T
   // factor in place (no intermediate copy of it).
   SparseCholeskyFactor(const cholmod_factor* factor, cholmod_common* common);
+  // Copies any LL^T factor of P A P^T: for_each_column(f) calls
+  // f(j, L_jj, rows, values) for j = 0 .. n - 1 in order with column j's
+  // entries below the diagonal (f may reorder and change the vectors), and
+  // permutation[k] is P's k-th pivot (CHOLMOD's Perm).
+  using ColumnVisitor =
+      std::function<void(int, double, std::vector<int>*, std::vector<double>*)>;
+  SparseCholeskyFactor(
+      std::vector<int> permutation,
+      const std::function<void(const ColumnVisitor&)>& for_each_column);
 
   int size() const { return n_; }
   // X = B A^{-1} for B of size r x size(); X may not alias B. The r rows are
@@ -85,6 +96,9 @@ class SparseCholeskyFactor {
   int64_t memory_bytes() const;
 
  private:
+  // The constructors' common part.
+  void Build(std::vector<int> permutation,
+             const std::function<void(const ColumnVisitor&)>& for_each_column);
   // The solve schedule (see the top of this file), built by the constructor.
   void BuildSchedule();
   // W = W L^{-1} (forward) or W = W L^{-T} (backward) restricted to the
