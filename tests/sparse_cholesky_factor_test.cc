@@ -5,10 +5,13 @@
 
 #include "ceres_sesync/internal/sparse_cholesky_factor.h"
 
+#include <algorithm>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "Eigen/Dense"
+#include "ceres_sesync/internal/extended_cholesky.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "gtest/gtest.h"
 
@@ -90,6 +93,68 @@ TEST_P(SparseCholeskyFactorTest, SolveRowsMatchesDenseSolve) {
       dense.llt().solve(padded.transpose()).transpose();
   ASSERT_EQ(tail_X.cols(), n - offset);
   EXPECT_LT((tail_X - full.rightCols(n - offset)).norm() / full.norm(), 1e-12);
+}
+
+// The supernodal constructor, from extended_cholesky.h's double factor of
+// P A P^T (a random ordering P): the same solves as a dense LLT of A, for
+// every rank r the fixed-size kernels cover, and the tail solve.
+TEST(SparseCholeskyFactor, FromSupernodesMatchesDenseSolve) {
+  const int n = 300;
+  const SparseMatrix A = RandomSpd(n, 900, 11);
+  std::vector<int> ordering(n), position(n);
+  for (int k = 0; k < n; ++k) ordering[k] = k;
+  std::shuffle(ordering.begin(), ordering.end(), std::mt19937(3));
+  for (int k = 0; k < n; ++k) position[ordering[k]] = k;
+  // The upper triangle of P A P^T in compressed columns.
+  std::vector<std::vector<std::pair<int, double>>> columns(n);
+  for (int c = 0; c < n; ++c) {
+    for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
+      const int pr = position[it.row()], pc = position[c];
+      columns[std::max(pr, pc)].emplace_back(std::min(pr, pc), it.value());
+    }
+  }
+  std::vector<int> start(1, 0), row;
+  std::vector<double> value;
+  for (auto& column : columns) {
+    std::sort(column.begin(), column.end());
+    for (const auto& [r, v] : column) {
+      row.push_back(r);
+      value.push_back(v);
+    }
+    start.push_back(static_cast<int>(row.size()));
+  }
+  DoubleDoubleCholesky chol;
+  chol.Analyze(n, start, row);
+  ASSERT_TRUE(chol.Factorize(value));
+  ASSERT_GT(chol.num_supernodes(), 1);
+  const SparseCholeskyFactor solver(
+      ordering, [&](const SparseCholeskyFactor::SupernodeVisitor& visit) {
+        chol.ForEachSupernode(visit);
+      });
+  ASSERT_EQ(solver.size(), n);
+  EXPECT_EQ(solver.num_supernodes(), chol.num_supernodes());
+  const Eigen::MatrixXd dense =
+      Eigen::MatrixXd(A).selfadjointView<Eigen::Lower>();
+  for (int r = 1; r <= 7; ++r) {
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(r, n);
+    Eigen::MatrixXd X;
+    solver.SolveRows(B, &X);
+    // cond(A) is small (diagonal dominance): agreement to a modest multiple
+    // of machine epsilon.
+    const Eigen::MatrixXd expected =
+        dense.llt().solve(B.transpose()).transpose();
+    EXPECT_LT((X - expected).norm() / expected.norm(), 1e-12) << r;
+    const int offset = 120;
+    const Eigen::MatrixXd tail_B = Eigen::MatrixXd::Random(r, n - offset);
+    Eigen::MatrixXd padded = Eigen::MatrixXd::Zero(r, n);
+    padded.rightCols(n - offset) = tail_B;
+    Eigen::MatrixXd tail_X;
+    solver.SolveRowsTail(tail_B, offset, &tail_X);
+    const Eigen::MatrixXd full =
+        dense.llt().solve(padded.transpose()).transpose();
+    EXPECT_LT((tail_X - full.rightCols(n - offset)).norm() / full.norm(), 1e-12)
+        << r;
+  }
 }
 
 // The certificate relies on the factorization failing for matrices that are

@@ -240,8 +240,9 @@ void CertificateMatrix::ReleaseFactor() {
 SparseCholeskyFactor CertificateMatrix::ExtractFactor() const {
   CHECK(double_factorized_) << "ExtractFactor() without a factor";
   return SparseCholeskyFactor(
-      ordering_, [this](const SparseCholeskyFactor::ColumnVisitor& column) {
-        double_->ForEachColumn(column);
+      ordering_,
+      [this](const SparseCholeskyFactor::SupernodeVisitor& supernode) {
+        double_->ForEachSupernode(supernode);
       });
 }
 

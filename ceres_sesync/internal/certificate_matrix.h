@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "ceres_sesync/internal/sesync_problem.h"
+#include "ceres_sesync/internal/sparse_cholesky_factor.h"
 
 namespace ceres_sesync::internal {
 

@@ -1093,25 +1093,15 @@ const std::vector<DoubleDouble>& DoubleDoubleCholesky::factor_value() const {
   return factor_value_;
 }
 
-void DoubleDoubleCholesky::ForEachColumn(
-    const std::function<void(int, double, std::vector<int>*,
-                             std::vector<double>*)>& f) const {
-  CHECK(factorized_);
-  std::vector<int> rows;
-  std::vector<double> values;
-  for (int c = 0; c < n_; ++c) {
-    rows.clear();
-    values.clear();
-    double diagonal = 0;
-    ForEachEntry(c, [&](int row, const DoubleDouble& l) {
-      if (row == c) {
-        diagonal = l.hi;
-      } else {
-        rows.push_back(row);
-        values.push_back(l.hi);
-      }
-    });
-    f(c, diagonal, &rows, &values);
+void DoubleDoubleCholesky::ForEachSupernode(
+    const std::function<void(int, int, const int*, int, const double*)>& f)
+    const {
+  CHECK(factorized_ && options_.supernodal);
+  for (int s = 0; s < num_supernodes(); ++s) {
+    f(super_start_[s], super_start_[s + 1] - super_start_[s],
+      super_row_.data() + super_row_start_[s],
+      super_row_start_[s + 1] - super_row_start_[s],
+      super_hi_.data() + super_value_start_[s]);
   }
 }
 

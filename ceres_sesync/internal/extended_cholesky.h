@@ -107,12 +107,13 @@ class DoubleDoubleCholesky {
   bool extended() const { return extended_factor_; }
   // Frees the numeric factor (the dense blocks); the analysis is kept.
   void ReleaseNumericFactor();
-  // After a successful Factorize(): f(column, diagonal, rows, values) for
-  // every column of L in order, with its entries below the diagonal (rows
-  // increasing), the high parts only (for SparseCholeskyFactor). Reuses
-  // the vectors between calls.
-  void ForEachColumn(const std::function<void(int, double, std::vector<int>*,
-                                              std::vector<double>*)>& f) const;
+  // After a successful supernodal Factorize(): f(first, ncols, rows, nrows,
+  // values) for every supernode in order: columns first .. first + ncols -
+  // 1, their rows rows[0 .. nrows) (the columns, then the rows below them,
+  // ascending) and the nrows x ncols block of L, column-major, high parts
+  // only (for SparseCholeskyFactor's supernodal constructor).
+  void ForEachSupernode(const std::function<void(int, int, const int*, int,
+                                                 const double*)>& f) const;
 
   // After a successful Factorize(): rho_i >= sum_j |E_ij| for every row i
   // (permuted order), with the rounding of this computation itself covered.

@@ -83,8 +83,44 @@ SparseCholeskyFactor::SparseCholeskyFactor(const cholmod_factor* factor,
 
 SparseCholeskyFactor::SparseCholeskyFactor(
     std::vector<int> permutation,
-    const std::function<void(const ColumnVisitor&)>& for_each_column) {
-  Build(std::move(permutation), for_each_column);
+    const std::function<void(const SupernodeVisitor&)>& for_each_supernode) {
+  n_ = static_cast<int>(permutation.size());
+  permutation_ = std::move(permutation);
+  // Two passes: the first counts what the second stores.
+  int64_t num_values = 0, num_rows = 0, num_supernodes = 0;
+  for_each_supernode([&](int, int c, const int*, int nrows, const double*) {
+    const int64_t nb = nrows - c;
+    num_values += static_cast<int64_t>(c) * (c + 1) / 2 + nb * c;
+    num_rows += nb;
+    ++num_supernodes;
+  });
+  values_.reserve(num_values);
+  row_index_.reserve(num_rows);
+  first_.reserve(num_supernodes + 1);
+  rows_.reserve(num_supernodes);
+  int next = 0;  // The first column of the next supernode.
+  for_each_supernode(
+      [&](int first, int c, const int* rows, int nrows, const double* x) {
+        CHECK_EQ(first, next) << "supernodes out of order";
+        next = first + c;
+        first_.push_back(first);
+        rows_.push_back(nrows - c);
+        row_index_.insert(row_index_.end(), rows + c, rows + nrows);
+        auto at = [x, nrows](int i, int k) {
+          return x[i + static_cast<int64_t>(k) * nrows];
+        };
+        for (int k = 0; k < c; ++k) {  // The triangle, row by row.
+          for (int q = 0; q < k; ++q) values_.push_back(at(k, q));
+          values_.push_back(1.0 / at(k, k));
+        }
+        for (int i = c; i < nrows; ++i) {  // The rectangle, row by row.
+          for (int k = 0; k < c; ++k) values_.push_back(at(i, k));
+        }
+      });
+  CHECK_EQ(next, n_) << "supernodes do not cover the columns";
+  stored_entries_ = num_values;
+  first_.push_back(n_);
+  BuildSchedule();
 }
 
 void SparseCholeskyFactor::Build(

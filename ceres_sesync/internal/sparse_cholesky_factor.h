@@ -1,5 +1,5 @@
 // A sparse Cholesky factor P A P^T = L L^T, copied once from CHOLMOD's or
-// extended_cholesky.h's (in double), with
+// from supernodes (extended_cholesky.h's double factor), with
 // triangular solves specialized for the SE-Sync data layout: the right-hand
 // side is an r x N matrix whose N columns are the (vector-valued) unknowns, so
 // X = B A^{-1} is solved in one pass over L with contiguous r-vector updates.
@@ -55,15 +55,19 @@ class SparseCholeskyFactor {
   // P A P^T; `factor` is unchanged. Reads a supernodal or simplicial LL^T
   // factor in place (no intermediate copy of it).
   SparseCholeskyFactor(const cholmod_factor* factor, cholmod_common* common);
-  // Copies any LL^T factor of P A P^T: for_each_column(f) calls
-  // f(j, L_jj, rows, values) for j = 0 .. n - 1 in order with column j's
-  // entries below the diagonal (f may reorder and change the vectors), and
-  // permutation[k] is P's k-th pivot (CHOLMOD's Perm).
-  using ColumnVisitor =
-      std::function<void(int, double, std::vector<int>*, std::vector<double>*)>;
+  // Copies a supernodal LL^T factor of P A P^T (permutation[k] = P's k-th
+  // pivot, CHOLMOD's Perm) given as fundamental supernodes:
+  // for_each_supernode(f) calls f(first, ncols, rows, nrows, values) for the
+  // supernodes in column order, where columns first .. first + ncols - 1
+  // have the rows rows[0 .. nrows) (the columns themselves, then the rows
+  // below them, ascending, the same for every column) and values is the
+  // nrows x ncols block, column-major (leading dimension nrows; its entries
+  // above the diagonal are not read). Kept as given: no zeros are dropped.
+  using SupernodeVisitor = std::function<void(
+      int first, int ncols, const int* rows, int nrows, const double* values)>;
   SparseCholeskyFactor(
       std::vector<int> permutation,
-      const std::function<void(const ColumnVisitor&)>& for_each_column);
+      const std::function<void(const SupernodeVisitor&)>& for_each_supernode);
 
   int size() const { return n_; }
   // X = B A^{-1} for B of size r x size(); X may not alias B. The r rows are
@@ -96,7 +100,9 @@ class SparseCholeskyFactor {
   int64_t memory_bytes() const;
 
  private:
-  // The constructors' common part.
+  // The CHOLMOD constructor's copy, column by column.
+  using ColumnVisitor =
+      std::function<void(int, double, std::vector<int>*, std::vector<double>*)>;
   void Build(std::vector<int> permutation,
              const std::function<void(const ColumnVisitor&)>& for_each_column);
   // The solve schedule (see the top of this file), built by the constructor.
