@@ -163,6 +163,15 @@ DoubleDoubleCholesky::Options Supernodal(bool vectorize) {
   return options;
 }
 
+// The supernodal scheme on `threads` threads, its tree split however small
+// the matrix.
+DoubleDoubleCholesky::Options Split(int threads) {
+  DoubleDoubleCholesky::Options options;
+  options.min_split_flops = 0;
+  options.num_threads = threads;
+  return options;
+}
+
 DoubleDoubleCholesky::Options Simplicial() {
   DoubleDoubleCholesky::Options options;
   options.supernodal = false;
@@ -254,6 +263,39 @@ int BitwiseDifferences(const DoubleDoubleCholesky& x,
   return differences;
 }
 
+// The largest |x_ij - reference_ij| over the (common) pattern, relative to
+// the largest |L_ij| of its row in `reference`.
+double WorstDifference(const DoubleDoubleCholesky& x,
+                       const DoubleDoubleCholesky& reference) {
+  EXPECT_EQ(x.factor_row(), reference.factor_row());
+  const std::vector<double> row_max = RowMax(reference);
+  double worst = 0;
+  for (size_t p = 0; p < reference.factor_row().size(); ++p) {
+    const Quad d =
+        ToQuad(x.factor_value()[p]) - ToQuad(reference.factor_value()[p]);
+    worst = std::max(worst, static_cast<double>(Abs(d)) /
+                                row_max[reference.factor_row()[p]]);
+  }
+  return worst;
+}
+
+// The true residual of a factorization of m against its bound: the largest
+// ratio over the rows of sum_j |(L L^T - A)_ij| to rho_i, and max_i rho_i.
+struct ResidualCheck {
+  double worst_ratio = 0, max_rho = 0;
+};
+ResidualCheck CheckResidual(const DoubleDoubleCholesky& chol, const Matrix& m) {
+  std::vector<double> rho;
+  chol.RowBackwardErrorBounds(&rho);
+  const std::vector<double> residual = ResidualRowSums(chol, m);
+  ResidualCheck check;
+  for (int i = 0; i < m.n; ++i) {
+    check.worst_ratio = std::max(check.worst_ratio, residual[i] / rho[i]);
+    check.max_rho = std::max(check.max_rho, rho[i]);
+  }
+  return check;
+}
+
 struct Case {
   const char* name;
   Matrix matrix;
@@ -299,23 +341,9 @@ TEST(ExtendedCholesky, SupernodalMatchesReferenceAndItsBound) {
     ASSERT_TRUE(reference.Factorize(m.value)) << c.name;
     ASSERT_EQ(supernodal.factor_start(), reference.factor_start());
     ASSERT_EQ(supernodal.factor_row(), reference.factor_row());
-    const std::vector<double> row_max = RowMax(reference);
-    double worst_difference = 0;
-    for (size_t p = 0; p < reference.factor_row().size(); ++p) {
-      const Quad d = ToQuad(supernodal.factor_value()[p]) -
-                     ToQuad(reference.factor_value()[p]);
-      worst_difference =
-          std::max(worst_difference, static_cast<double>(Abs(d)) /
-                                         row_max[reference.factor_row()[p]]);
-    }
-    std::vector<double> rho;
-    supernodal.RowBackwardErrorBounds(&rho);
-    const std::vector<double> residual = ResidualRowSums(supernodal, m);
-    double worst_ratio = 0, max_rho = 0, max_a = 0;
-    for (int i = 0; i < m.n; ++i) {
-      worst_ratio = std::max(worst_ratio, residual[i] / rho[i]);
-      max_rho = std::max(max_rho, rho[i]);
-    }
+    const double worst_difference = WorstDifference(supernodal, reference);
+    const auto [worst_ratio, max_rho] = CheckResidual(supernodal, m);
+    double max_a = 0;
     for (const DoubleDouble& a : m.value)
       max_a = std::max(max_a, std::abs(a.hi));
     std::printf(
@@ -341,11 +369,7 @@ TEST(ExtendedCholesky, SupernodalMatchesReferenceAndItsBound) {
 TEST(ExtendedCholesky, SplitFactorizationIsSoundAndThreadIndependent) {
   for (const Case& c : Cases()) {
     const Matrix& m = c.matrix;
-    DoubleDoubleCholesky::Options options;
-    options.min_split_flops = 0;
-    DoubleDoubleCholesky one(options), reference(Simplicial());
-    options.num_threads = 2;
-    DoubleDoubleCholesky two(options);
+    DoubleDoubleCholesky one(Split(1)), two(Split(2)), reference(Simplicial());
     one.Analyze(m.n, m.start, m.row);
     two.Analyze(m.n, m.start, m.row);
     reference.Analyze(m.n, m.start, m.row);
@@ -357,33 +381,15 @@ TEST(ExtendedCholesky, SplitFactorizationIsSoundAndThreadIndependent) {
     ASSERT_TRUE(reference.Factorize(m.value)) << c.name;
     ASSERT_EQ(one.factor_row(), reference.factor_row());
     EXPECT_EQ(BitwiseDifferences(one, two), 0) << c.name;
-    const std::vector<double> row_max = RowMax(reference);
-    double worst_difference = 0;
-    for (size_t p = 0; p < reference.factor_row().size(); ++p) {
-      const Quad d =
-          ToQuad(one.factor_value()[p]) - ToQuad(reference.factor_value()[p]);
-      worst_difference =
-          std::max(worst_difference, static_cast<double>(Abs(d)) /
-                                         row_max[reference.factor_row()[p]]);
-    }
-    EXPECT_LT(worst_difference, 1e-23) << c.name;
-    std::vector<double> rho;
-    two.RowBackwardErrorBounds(&rho);
-    const std::vector<double> residual = ResidualRowSums(two, m);
-    double worst_ratio = 0;
-    for (int i = 0; i < m.n; ++i) {
-      worst_ratio = std::max(worst_ratio, residual[i] / rho[i]);
-    }
+    EXPECT_LT(WorstDifference(one, reference), 1e-23) << c.name;
+    const double worst_ratio = CheckResidual(two, m).worst_ratio;
     EXPECT_LE(worst_ratio, 1.0) << c.name;
     EXPECT_GT(worst_ratio, 0.0) << c.name;
   }
   // Indefinite: the Laplacian's null vector is constant, so every pivot
   // region is affected; rejected with one and with two threads.
   for (int threads : {1, 2}) {
-    DoubleDoubleCholesky::Options options;
-    options.min_split_flops = 0;
-    options.num_threads = threads;
-    DoubleDoubleCholesky chol(options);
+    DoubleDoubleCholesky chol(Split(threads));
     const Matrix negative = GridLaplacian(30, 30, 1, -1e-18, 4);
     chol.Analyze(negative.n, negative.start, negative.row);
     ASSERT_EQ(chol.num_bins(), 2);
@@ -413,13 +419,10 @@ TEST(ExtendedCholesky, DoubleFactorizationIsSoundAndThreadIndependent) {
     Matrix m = c.matrix;
     const std::vector<double> values = RoundedValues(m);
     for (size_t q = 0; q < values.size(); ++q) m.value[q] = values[q];
-    DoubleDoubleCholesky::Options options;
-    options.min_split_flops = 0;
-    DoubleDoubleCholesky one(options), extended(options);
-    options.num_threads = 2;
-    DoubleDoubleCholesky two(options);
-    options.vectorize = false;
-    DoubleDoubleCholesky portable(options);
+    DoubleDoubleCholesky::Options portable_options = Split(2);
+    portable_options.vectorize = false;
+    DoubleDoubleCholesky one(Split(1)), two(Split(2)), extended(Split(1)),
+        portable(portable_options);
     for (DoubleDoubleCholesky* chol : {&one, &two, &portable, &extended}) {
       chol->Analyze(m.n, m.start, m.row);
     }
@@ -432,24 +435,10 @@ TEST(ExtendedCholesky, DoubleFactorizationIsSoundAndThreadIndependent) {
     EXPECT_EQ(BitwiseDifferences(one, two), 0) << c.name;
     EXPECT_EQ(BitwiseDifferences(one, portable), 0) << c.name;
     ASSERT_EQ(one.factor_row(), extended.factor_row());
-    const std::vector<double> row_max = RowMax(extended);
-    double worst_difference = 0;
-    for (size_t p = 0; p < extended.factor_row().size(); ++p) {
-      EXPECT_EQ(one.factor_value()[p].lo, 0.0);
-      const Quad d =
-          ToQuad(one.factor_value()[p]) - ToQuad(extended.factor_value()[p]);
-      worst_difference =
-          std::max(worst_difference, static_cast<double>(Abs(d)) /
-                                         row_max[extended.factor_row()[p]]);
-    }
-    std::vector<double> rho;
-    two.RowBackwardErrorBounds(&rho);
-    const std::vector<double> residual = ResidualRowSums(two, m);
-    double worst_ratio = 0, max_rho = 0, max_a = 0;
-    for (int i = 0; i < m.n; ++i) {
-      worst_ratio = std::max(worst_ratio, residual[i] / rho[i]);
-      max_rho = std::max(max_rho, rho[i]);
-    }
+    for (const DoubleDouble& l : one.factor_value()) EXPECT_EQ(l.lo, 0.0);
+    const double worst_difference = WorstDifference(one, extended);
+    const auto [worst_ratio, max_rho] = CheckResidual(two, m);
+    double max_a = 0;
     for (double a : values) max_a = std::max(max_a, std::abs(a));
     std::printf(
         "%s (double): difference from double-double %.3g; residual / bound "
@@ -463,10 +452,7 @@ TEST(ExtendedCholesky, DoubleFactorizationIsSoundAndThreadIndependent) {
   // The smallest eigenvalue about -/+ 1e-8 (the shift) of entries ~10, far
   // above double's resolution: rejected / factored.
   for (int threads : {1, 2}) {
-    DoubleDoubleCholesky::Options options;
-    options.min_split_flops = 0;
-    options.num_threads = threads;
-    DoubleDoubleCholesky chol(options);
+    DoubleDoubleCholesky chol(Split(threads));
     const Matrix negative = GridLaplacian(30, 30, 1, -1e-8, 4);
     chol.Analyze(negative.n, negative.start, negative.row);
     ASSERT_EQ(chol.num_bins(), 2);

@@ -55,6 +55,31 @@ SparseMatrix RandomSpd(int n, int extra_edges, unsigned seed) {
   });
 }
 
+// X = B A^{-1} and the tail solve (A's leading `offset` = 120 unknowns with
+// a zero right-hand side, dropped from the result) for random B with r
+// rows, against a dense LLT of A. cond(A) is small (diagonal dominance), so
+// both agree to a modest multiple of machine epsilon.
+void ExpectSolvesMatchDense(const SparseCholeskyFactor& solver,
+                            const Eigen::MatrixXd& dense, int r) {
+  const int n = static_cast<int>(dense.rows());
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(r, n);
+  Eigen::MatrixXd X;
+  solver.SolveRows(B, &X);
+  const Eigen::MatrixXd expected = dense.llt().solve(B.transpose()).transpose();
+  EXPECT_LT((X - expected).norm() / expected.norm(), 1e-12) << r;
+  const int offset = 120;
+  const Eigen::MatrixXd tail_B = Eigen::MatrixXd::Random(r, n - offset);
+  Eigen::MatrixXd padded = Eigen::MatrixXd::Zero(r, n);
+  padded.rightCols(n - offset) = tail_B;
+  Eigen::MatrixXd tail_X;
+  solver.SolveRowsTail(tail_B, offset, &tail_X);
+  const Eigen::MatrixXd full =
+      dense.llt().solve(padded.transpose()).transpose();
+  ASSERT_EQ(tail_X.cols(), n - offset);
+  EXPECT_LT((tail_X - full.rightCols(n - offset)).norm() / full.norm(), 1e-12)
+      << r;
+}
+
 class SparseCholeskyFactorTest
     : public ::testing::TestWithParam<std::tuple<bool, int>> {};
 
@@ -71,28 +96,8 @@ TEST_P(SparseCholeskyFactorTest, SolveRowsMatchesDenseSolve) {
   const SparseCholeskyFactor solver = factor.ExtractFactor();
   ASSERT_EQ(solver.size(), n);
 
-  const Eigen::MatrixXd dense =
-      Eigen::MatrixXd(A).selfadjointView<Eigen::Lower>();
-  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(r, n);
-  Eigen::MatrixXd X;
-  solver.SolveRows(B, &X);
-  // Reference: X^T = A^{-1} B^T. cond(A) is small (diagonal dominance), so
-  // both solutions agree to a modest multiple of machine epsilon.
-  const Eigen::MatrixXd expected = dense.llt().solve(B.transpose()).transpose();
-  EXPECT_LT((X - expected).norm() / expected.norm(), 1e-12);
-
-  // Tail solve: A's leading `offset` unknowns have zero right-hand side and
-  // are dropped from the result.
-  const int offset = 120;
-  const Eigen::MatrixXd tail_B = Eigen::MatrixXd::Random(r, n - offset);
-  Eigen::MatrixXd padded = Eigen::MatrixXd::Zero(r, n);
-  padded.rightCols(n - offset) = tail_B;
-  Eigen::MatrixXd tail_X;
-  solver.SolveRowsTail(tail_B, offset, &tail_X);
-  const Eigen::MatrixXd full =
-      dense.llt().solve(padded.transpose()).transpose();
-  ASSERT_EQ(tail_X.cols(), n - offset);
-  EXPECT_LT((tail_X - full.rightCols(n - offset)).norm() / full.norm(), 1e-12);
+  ExpectSolvesMatchDense(solver,
+                         Eigen::MatrixXd(A).selfadjointView<Eigen::Lower>(), r);
 }
 
 // The supernodal constructor, from extended_cholesky.h's double factor of
@@ -135,26 +140,7 @@ TEST(SparseCholeskyFactor, FromSupernodesMatchesDenseSolve) {
   EXPECT_EQ(solver.num_supernodes(), chol.num_supernodes());
   const Eigen::MatrixXd dense =
       Eigen::MatrixXd(A).selfadjointView<Eigen::Lower>();
-  for (int r = 1; r <= 7; ++r) {
-    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(r, n);
-    Eigen::MatrixXd X;
-    solver.SolveRows(B, &X);
-    // cond(A) is small (diagonal dominance): agreement to a modest multiple
-    // of machine epsilon.
-    const Eigen::MatrixXd expected =
-        dense.llt().solve(B.transpose()).transpose();
-    EXPECT_LT((X - expected).norm() / expected.norm(), 1e-12) << r;
-    const int offset = 120;
-    const Eigen::MatrixXd tail_B = Eigen::MatrixXd::Random(r, n - offset);
-    Eigen::MatrixXd padded = Eigen::MatrixXd::Zero(r, n);
-    padded.rightCols(n - offset) = tail_B;
-    Eigen::MatrixXd tail_X;
-    solver.SolveRowsTail(tail_B, offset, &tail_X);
-    const Eigen::MatrixXd full =
-        dense.llt().solve(padded.transpose()).transpose();
-    EXPECT_LT((tail_X - full.rightCols(n - offset)).norm() / full.norm(), 1e-12)
-        << r;
-  }
+  for (int r = 1; r <= 7; ++r) ExpectSolvesMatchDense(solver, dense, r);
 }
 
 // The certificate relies on the factorization failing for matrices that are

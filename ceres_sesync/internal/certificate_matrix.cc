@@ -205,7 +205,7 @@ void CertificateMatrix::Assemble(const Eigen::MatrixXd& Lambda, double c,
 double CertificateMatrix::PredictedSeconds(ProofPrecision precision) const {
   if (precision == ProofPrecision::kDouble) return last_double_seconds_;
   return last_extended_seconds_ > 0 ? last_extended_seconds_
-                                    : 3.4 * last_double_seconds_;
+                                    : 4.6 * last_double_seconds_;
 }
 
 bool CertificateMatrix::FactorizeDouble() {

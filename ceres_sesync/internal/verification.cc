@@ -224,7 +224,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     return 1.0 / eigs.eigenvalues()(0) - shift;
   };
   // Double-double proofs from the goal up to the tolerance; the first
-  // success ends them (each costs 1-3.4 double factorizations, measured).
+  // success ends them (each costs 1.8-4.6 double factorizations, measured).
   // When the goal fails (lambda_min(S) < -goal), the next shifts come from
   // an estimate of lambda_min(S) if the double factor at eta_max is at hand
   // (`factor_at_eta_max`), else by factors of 8, so that the proven bound
