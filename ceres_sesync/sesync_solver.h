@@ -176,17 +176,17 @@ struct SolverOptions {
   // shift (certification_max_relative_bound * F(Y) / (2 d n)), in double
   // where double can prove it, else double-double, whenever the
   // Hessian-vector products since the last test number at least twice a
-  // factorization's cost in products (CHOLMOD's flop prediction, a
-  // double-double test priced at 1.5 double ones; not a time, so results
-  // do not depend on the machine's load or the thread count) and half the
-  // level's products so far (the 10^6-pose city: certified after 175 or
-  // 491 rank-5 products, on two trajectories that differ in round-off: a
-  // test's outcome near the tolerance is marginal). The level stops at the
-  // first test that passes; its proof stands, and the level's verification
-  // tightens it in double where double reaches below it. The returned poses
-  // are the same (rounding refines them to the same local optimum); the
-  // proven bound is within the tolerance but can be looser than after a
-  // converged descent (large maps, where only double-double reaches it:
+  // factorization's cost in products (the symbolic analysis's flop count,
+  // a double-double test priced at 1.5 double ones; not a time, so results
+  // do not depend on the machine's load or the thread count) and a quarter
+  // of the level's products so far (the 10^6-pose city: certified after
+  // 173-175 rank-5 products; with half, 175 or 491 on two trajectories that
+  // differ in round-off: a test's outcome near the tolerance is marginal). The
+  // level stops at the first test that passes; its proof stands, and the
+  // level's verification tightens it in double where double reaches below it.
+  // The returned poses are the same (rounding refines them to the same local
+  // optimum); the proven bound is within the tolerance but can be looser than
+  // after a converged descent (large maps, where only double-double reaches it:
   // about half the tolerance). Off: every level runs to the local solver's
   // tests.
   bool test_certificate_after_escape = true;

@@ -511,26 +511,31 @@ void Staircase::Optimize(int rank, bool test_certificate,
     if (!CertificateTestArithmetic(eta, &precision)) return true;
     // Due when the products since the last test cost at least twice a
     // factorization (so tests cost at most about half the optimization)
-    // and number at least half the level's (a long descent is tested a
-    // logarithmic number of times). The price is counted, not timed: the
-    // prices may not depend on the thread count (results are the same for
-    // every num_threads). FactorizationCostInSolves matched CHOLMOD's double
-    // factorization in time, and a double-double test is priced at 1.5 of
-    // it: measured 1.6-2.0x on one thread, ~0.9x on two at 10^6 poses
-    // (42-47 s against CHOLMOD's serial ~50 s). At 2.5 the 10^6-pose city's
-    // first test came at 298 products; on that trajectory it passes from
-    // 175 on (one differing in round-off failed at 175: the outcome there is
-    // marginal). Double factorizations run in 1/3-1/6 of CHOLMOD's time
-    // since (extended_cholesky.h), so double tests are overpriced; a price
-    // of 0.25 saved no product on nine kappa-30 10^5-pose cities (one went
-    // from 648 to 824), the geometric rule deciding.
-    // The price is in products of the level's nominal rank, as calibrated; a
-    // level run on fewer nonzero rows (above) does fewer solves per product,
-    // so its tests come sooner in time than the rule says.
+    // and number at least a quarter of the level's (a long descent is
+    // tested a logarithmic number of times, the products growing by 4/3 or
+    // more between tests). A half (doubling) let a failed test near the
+    // point where the certificate becomes provable wait for twice its
+    // products: kappa-30 10^5-pose cities 349 / 1023 / 399 -> 211 / 835 /
+    // 256 rank-5 products with a quarter (six other seeds unchanged), the
+    // scaling bench's 10^6-pose city 492 -> 174. The price is counted, not
+    // timed: the prices may not depend on the thread count (results are the
+    // same for every num_threads). FactorizationCostInSolves matched CHOLMOD's
+    // double factorization in time, and a double-double test is priced at 1.5
+    // of it: measured 1.6-2.0x on one thread, ~0.9x on two at 10^6 poses (42-47
+    // s against CHOLMOD's serial ~50 s). At 2.5 the 10^6-pose city's first test
+    // came at 298 products; on that trajectory it passes from 175 on (one
+    // differing in round-off failed at 175: the outcome there is marginal).
+    // Double factorizations run in 1/3-1/6 of CHOLMOD's time since
+    // (extended_cholesky.h), so double tests are overpriced; a price of 0.25
+    // saved no product on nine kappa-30 10^5-pose cities (one went from 648 to
+    // 824), the geometric rule deciding. The price is in products of the
+    // level's nominal rank, as calibrated; a level run on fewer nonzero rows
+    // (above) does fewer solves per product, so its tests come sooner in time
+    // than the rule says.
     const double cost = certificate_->FactorizationCostInSolves(rank) *
                         (precision == ProofPrecision::kDouble ? 1.0 : 1.5);
     const int since = level_products - last_test_products;
-    if (since < std::max(2 * cost, 0.5 * level_products)) return true;
+    if (since < std::max(2 * cost, 0.25 * level_products)) return true;
     last_test_products = level_products;
     const auto test_start = Clock::now();
     const bool passed = TestCertificate(eta, precision, level);
