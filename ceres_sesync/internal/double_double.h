@@ -300,6 +300,12 @@ inline bool operator==(const DoubleDouble& x, const DoubleDouble& y) {
   return x.hi == y.hi && x.lo == y.lo;
 }
 
+// Higham's gamma_k = k u / (1 - k u) for double, u = 2^-53.
+inline double DoubleGamma(double k) {
+  constexpr double u = 0x1p-53;
+  return k * u / (1 - k * u);
+}
+
 // gamma_k = k w / (1 - k w) for w = kDoubleDoubleUnitRoundoff (Higham's
 // gamma for this arithmetic).
 inline double DoubleDoubleGamma(double k) {

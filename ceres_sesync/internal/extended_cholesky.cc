@@ -30,7 +30,6 @@ namespace {
 constexpr double kSmallestSafeValue = 0x1p-900;
 constexpr double kLargestSafeValue = 0x1p900;
 constexpr double kUnderflowError = 0x1p-1070;
-constexpr double kUnitRoundoff = 0x1p-53;  // Of double.
 
 bool Safe(const DoubleDouble& x) {
   const double a = std::abs(x.hi);
@@ -239,6 +238,13 @@ template <class Lanes, int kRows, int kColumns>
   }
 }
 
+// p + at for the low parts of double-double data; null in double, which
+// has none.
+template <bool kExtended, typename T>
+[[gnu::always_inline]] inline T* LowPart(T* p, long long at) {
+  return kExtended ? p + at : nullptr;
+}
+
 // The same in double: C(i, j) <- C(i, j) - A(i, l) B(j, l) for l = 0 ..
 // count - 1 in order, one FMA (a single rounding) per product.
 template <class Lanes, int kRows, int kColumns>
@@ -305,8 +311,7 @@ template <class Lanes, bool kExtended, int kColumns>
   const double* b_hi = u.b_hi + b0;
   const double* b_lo = kExtended ? u.b_lo + b0 : nullptr;
   const long long c0 = static_cast<long long>(j0) * u.ldc;
-  // The low parts at offset `at` (none in double).
-  auto lo = [](auto* p, long long at) { return kExtended ? p + at : nullptr; };
+  auto lo = [](auto* p, long long at) { return LowPart<kExtended>(p, at); };
   int i = std::max(i0, j0);
   for (; i + kRows * W <= i1; i += kRows * W) {
     Tile<Lanes, kExtended, kRows, kColumns>(
@@ -454,6 +459,11 @@ struct Kernels {
   void (*scale)(int m, double* x_hi, double* x_lo, double y_hi, double y_lo);
   void (*update_double)(const UpdateBlock&);  // Only the high parts.
   void (*divide)(int m, double* x, double y);
+  // The update of either arithmetic.
+  template <bool kExtended>
+  auto Update() const {
+    return kExtended ? update : update_double;
+  }
 };
 
 // Factors one supernode in place after all updates from below: its nrows x
@@ -473,14 +483,14 @@ template <bool kExtended>
 bool FactorSupernode(const Kernels& kernels, int nrows, int ncols, double* hi,
                      double* lo) {
   const int ld = nrows;
-  // Entry (i, j) of the block (no low parts in double).
-  auto at = [ld](double* x, int i, int j) {
-    return kExtended ? x + i + static_cast<long long>(j) * ld : nullptr;
-  };
+  // Entry (i, j) of the block, high and low parts (none in double).
   auto at_hi = [ld](double* x, int i, int j) {
     return x + i + static_cast<long long>(j) * ld;
   };
-  const auto update = kExtended ? kernels.update : kernels.update_double;
+  auto at = [ld](double* x, int i, int j) {
+    return LowPart<kExtended>(x, i + static_cast<long long>(j) * ld);
+  };
+  const auto update = kernels.Update<kExtended>();
   for (int c0 = 0; c0 < ncols; c0 += kPanel) {
     const int c1 = std::min(ncols, c0 + kPanel);
     if (c0 > 0) {
@@ -742,7 +752,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       vectorized_ ? Kernels{UpdateAvx2, ScaleAvx2, UpdateDoubleAvx2, DivideAvx2}
                   : Kernels{UpdatePortable, ScalePortable, UpdateDoublePortable,
                             DividePortable};
-  const auto update_kernel = kExtended ? kernels.update : kernels.update_double;
+  const auto update_kernel = kernels.Update<kExtended>();
   // The dense blocks, kept as the factor: allocated once per analysis and
   // left unwritten here. Each column is zeroed and filled with its values
   // by the thread that factors it (fill_columns below), so that the first
@@ -760,8 +770,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     HugePageVector<double>().swap(super_lo);
     super_lo.resize(kExtended ? entries : 0);
   }
-  // The low parts at offset `at` (none in double).
-  auto lo = [](auto* p, long long at) { return kExtended ? p + at : nullptr; };
+  auto lo = [](auto* p, long long at) { return LowPart<kExtended>(p, at); };
   // Zeros columns c0 .. c1 - 1 of supernode s (nrows rows, values s_hi and
   // s_lo) and scatters A's values into them.
   auto fill_columns = [&](int s, int c0, int c1, int nrows, double* s_hi,
@@ -986,16 +995,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
 bool DoubleDoubleCholesky::Factorize(
     const std::vector<double>& values,
     std::chrono::steady_clock::time_point deadline) {
-  CHECK(options_.supernodal) << "double: the supernodal scheme only";
-  CHECK_EQ(values.size(), row_index_.size());
-  timed_out_ = false;
-  extended_factor_ = false;
-  factor_value_.clear();
-  for (double v : values) {
-    if (!Safe(DoubleDouble(v))) return factorized_ = false;
-  }
-  factorized_ = FactorizeSupernodal(values, deadline);
-  return factorized_;
+  return FactorizeValues(values, deadline);
 }
 
 void DoubleDoubleCholesky::ReleaseNumericFactor() {
@@ -1008,21 +1008,33 @@ void DoubleDoubleCholesky::ReleaseNumericFactor() {
 bool DoubleDoubleCholesky::Factorize(
     const std::vector<DoubleDouble>& values,
     std::chrono::steady_clock::time_point deadline) {
+  return FactorizeValues(values, deadline);
+}
+
+template <typename Value>
+bool DoubleDoubleCholesky::FactorizeValues(
+    const std::vector<Value>& values,
+    std::chrono::steady_clock::time_point deadline) {
+  constexpr bool kExtended = std::is_same_v<Value, DoubleDouble>;
   CHECK_EQ(values.size(), row_index_.size());
   timed_out_ = false;
-  extended_factor_ = true;
-  for (const DoubleDouble& v : values) {
-    if (!Safe(v)) return factorized_ = false;
+  extended_factor_ = kExtended;
+  for (const Value& v : values) {
+    if (!Safe(DoubleDouble(v))) return factorized_ = false;
   }
-  if (options_.supernodal) {
-    factorized_ = FactorizeSupernodal(values, deadline);
-    return factorized_;
+  if constexpr (kExtended) {
+    if (!options_.supernodal) {
+      std::vector<int> fill(n_);
+      factorized_ =
+          FactorizeRows(n_, column_start_.data(), row_index_.data(),
+                        values.data(), parent_.data(), factor_start_.data(),
+                        factor_row_.data(), factor_value_.data(), fill.data());
+      return factorized_;
+    }
+  } else {
+    CHECK(options_.supernodal) << "double: the supernodal scheme only";
   }
-  std::vector<int> fill(n_);
-  factorized_ =
-      FactorizeRows(n_, column_start_.data(), row_index_.data(), values.data(),
-                    parent_.data(), factor_start_.data(), factor_row_.data(),
-                    factor_value_.data(), fill.data());
+  factorized_ = FactorizeSupernodal(values, deadline);
   return factorized_;
 }
 
@@ -1060,9 +1072,8 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
     const double entries =
         row_count_[i] + (factor_start_[i + 1] - factor_start_[i]);
     const double m = row_count_[i] + 1;
-    const double gamma = extended_factor_
-                             ? DoubleDoubleGamma(m)
-                             : m * kUnitRoundoff / (1 - m * kUnitRoundoff);
+    const double gamma =
+        extended_factor_ ? DoubleDoubleGamma(m) : DoubleGamma(m);
     (*rho)[i] = gamma * v[i] * (1 + 1e-6) + entries * underflow_per_entry;
   }
 }

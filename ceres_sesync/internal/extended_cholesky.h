@@ -176,7 +176,10 @@ class DoubleDoubleCholesky {
     const double* lo = super_lo_.data() + at;
     for (int t = jj; t < nrows; ++t) f(rows[t], DoubleDouble(hi[t], lo[t]));
   }
-  // Value: DoubleDouble or double.
+  // Both Factorize(); Value: DoubleDouble or double.
+  template <typename Value>
+  bool FactorizeValues(const std::vector<Value>& values,
+                       std::chrono::steady_clock::time_point deadline);
   template <typename Value>
   bool FactorizeSupernodal(const std::vector<Value>& values,
                            std::chrono::steady_clock::time_point deadline);

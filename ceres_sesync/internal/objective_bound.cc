@@ -1,14 +1,11 @@
 #include "ceres_sesync/internal/objective_bound.h"
 
 #include <cmath>
-#include <limits>
+
+#include "ceres_sesync/internal/double_double.h"
 
 namespace ceres_sesync::internal {
 namespace {
-
-constexpr double kU = std::numeric_limits<double>::epsilon() / 2;
-
-double Gamma(double k) { return k * kU / (1 - k * kU); }
 
 // Accumulates the squared residual entries r = x - y - sum_k A(p, k) z(k)
 // (y and A may be absent: null) into *value and their error bound into
@@ -43,7 +40,7 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
                            const LandmarkPositions& landmarks,
                            const MeasurementWeights& weights) {
   const int d = graph.dimension;
-  const double g = Gamma(d + 2);
+  const double g = DoubleGamma(d + 2);
   double f = 0, error = 0;
   for (size_t k = 0; k < graph.measurements.size(); ++k) {
     const RelativePoseMeasurement& e = graph.measurements[k];
@@ -103,7 +100,7 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
       (graph.measurements.size() + graph.landmark_measurements.size() +
        2.0 * graph.priors.size()) *
       (2.0 * d * d + 4);
-  return f + (2 * Gamma(terms) * (f + error) + error) * (1 + 1e-6);
+  return f + (2 * DoubleGamma(terms) * (f + error) + error) * (1 + 1e-6);
 }
 
 double TotalPrecision(const PoseGraph& graph,

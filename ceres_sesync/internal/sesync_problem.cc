@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <future>
-#include <limits>
 #include <utility>
 #include <vector>
 
+#include "ceres_sesync/internal/double_double.h"
 #include "ceres_sesync/internal/openmp_teams.h"
 #include "ceres_sesync/internal/parallel.h"
 #include "glog/logging.h"
@@ -14,7 +14,6 @@
 namespace ceres_sesync::internal {
 
 using Triplet = Eigen::Triplet<double>;
-constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
 
 namespace {
 
@@ -135,13 +134,11 @@ void CholmodFactor::RowBackwardErrorBounds(std::vector<double>* rho) {
   // entries in row i), so row i of the error is bounded by gamma_{k_i + 1} v_i.
   // The factor (1 + 1e-6) covers the rounding of computing v (sums of up to
   // 10^9 nonnegative terms, each within gamma_{10^9} < 1.2e-7).
-  const double unit_roundoff = std::numeric_limits<double>::epsilon() / 2;
   const int* perm = static_cast<const int*>(L.Perm);
   rho->assign(n, 0.0);
   for (int i = 0; i < n; ++i) {
-    const double m = row_count[i] + 1;
     (*rho)[perm ? perm[i] : i] =
-        m * unit_roundoff / (1 - m * unit_roundoff) * v[i] * (1 + 1e-6);
+        DoubleGamma(row_count[i] + 1) * v[i] * (1 + 1e-6);
   }
 }
 
@@ -379,9 +376,7 @@ void SESyncProblem::Assemble() {
   // the row's terms. The factor (1 + 1e-6) covers this computation's own
   // rounding.
   auto bound = [](int count, double abs_sum) {
-    const double g =
-        (count + 3) * kUnitRoundoff / (1 - (count + 3) * kUnitRoundoff);
-    return g * abs_sum * (1 + 1e-6);
+    return DoubleGamma(count + 3) * abs_sum * (1 + 1e-6);
   };
   translation_row_rounding_.resize(N);
   for (int i = 0; i < N; ++i)
