@@ -462,6 +462,50 @@ TEST(ExtendedCholesky, DoubleFactorizationIsSoundAndThreadIndependent) {
   }
 }
 
+// ShareAnalysis(): an object factoring with another's analysis computes
+// bitwise the factor of an object with its own analysis, in double and in
+// double-double; the two objects' numeric factors are independent (one
+// factoring different values leaves the other's factor and bounds as they
+// were); and the shared analysis outlives its owner's re-analysis of
+// another pattern.
+TEST(ExtendedCholesky, SharedAnalysisFactorsIndependently) {
+  const Matrix a = GridLaplacian(30, 30, 1, 1.0, 5);
+  const Matrix b = GridLaplacian(30, 30, 1, 0.5, 6);  // Same pattern.
+  ASSERT_EQ(a.row, b.row);
+  ASSERT_NE(a.value[0].hi, b.value[0].hi);
+  DoubleDoubleCholesky owner(Split(2)), sharer(Split(2)),
+      reference_double(Split(2)), reference_extended(Split(2));
+  owner.Analyze(a.n, a.start, a.row);
+  sharer.ShareAnalysis(owner);
+  reference_double.Analyze(a.n, a.start, a.row);
+  reference_extended.Analyze(b.n, b.start, b.row);
+  EXPECT_EQ(sharer.size(), a.n);
+  EXPECT_EQ(sharer.num_bins(), owner.num_bins());
+  EXPECT_EQ(sharer.factor_nonzeros(), reference_double.factor_nonzeros());
+  EXPECT_EQ(sharer.flops(), reference_double.flops());
+  ASSERT_TRUE(owner.Factorize(RoundedValues(a)));
+  ASSERT_TRUE(sharer.Factorize(b.value));
+  ASSERT_TRUE(reference_double.Factorize(RoundedValues(a)));
+  ASSERT_TRUE(reference_extended.Factorize(b.value));
+  EXPECT_FALSE(owner.extended());
+  EXPECT_TRUE(sharer.extended());
+  ASSERT_EQ(sharer.factor_row(), reference_extended.factor_row());
+  EXPECT_EQ(BitwiseDifferences(owner, reference_double), 0);
+  EXPECT_EQ(BitwiseDifferences(sharer, reference_extended), 0);
+  std::vector<double> rho_owner, rho_reference;
+  owner.RowBackwardErrorBounds(&rho_owner);
+  reference_double.RowBackwardErrorBounds(&rho_reference);
+  EXPECT_EQ(rho_owner, rho_reference);
+  EXPECT_LE(CheckResidual(sharer, b).worst_ratio, 1.0);
+  // The owner analyzes another pattern; the sharer keeps the old one.
+  const Matrix other = GridLaplacian(7, 7, 7, 1.0, 7);
+  owner.Analyze(other.n, other.start, other.row);
+  ASSERT_TRUE(owner.Factorize(other.value));
+  EXPECT_EQ(sharer.size(), a.n);
+  ASSERT_TRUE(sharer.Factorize(b.value));
+  EXPECT_EQ(BitwiseDifferences(sharer, reference_extended), 0);
+}
+
 // The SIMD kernels (when the CPU has them) and the portable code compute
 // bitwise the same factor.
 TEST(ExtendedCholesky, SimdAndPortableKernelsAgreeBitwise) {

@@ -77,11 +77,13 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
   }
   SetData(K_);
   ordering_ = BlockOrdering(problem);
-  InitializePermutedPattern();
+  std::vector<int> permuted_start, permuted_row;
+  InitializePermutedPattern(&permuted_start, &permuted_row);
   DoubleDoubleCholesky::Options options;
   options.num_threads = problem_.num_threads();
   double_ = std::make_unique<DoubleDoubleCholesky>(options);
-  double_->Analyze(static_cast<int>(K_.rows()), permuted_start_, permuted_row_);
+  double_->Analyze(static_cast<int>(K_.rows()), std::move(permuted_start),
+                   std::move(permuted_row));
 }
 
 double CertificateMatrix::FactorizationCostInSolves(int r) const {
@@ -290,14 +292,15 @@ bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
   return false;
 }
 
-void CertificateMatrix::InitializePermutedPattern() {
+void CertificateMatrix::InitializePermutedPattern(
+    std::vector<int>* permuted_start, std::vector<int>* permuted_row) {
   const int size = static_cast<int>(K_.rows());
   std::vector<int>& position = position_;  // Original index -> pivot order.
   position.resize(size);
   for (int k = 0; k < size; ++k) position[ordering_[k]] = k;
   // The permuted upper triangle: entry (r >= c) of K_ goes to column
   // max(position) and row min(position).
-  std::vector<int>& start = permuted_start_;
+  std::vector<int>& start = *permuted_start;
   start.assign(size + 1, 0);
   const int* outer = K_.outerIndexPtr();
   const int* inner = K_.innerIndexPtr();
@@ -308,13 +311,13 @@ void CertificateMatrix::InitializePermutedPattern() {
   }
   for (int k = 0; k < size; ++k) start[k + 1] += start[k];
   std::vector<int> next(start.begin(), start.end() - 1);
-  permuted_row_.resize(K_.nonZeros());
+  permuted_row->resize(K_.nonZeros());
   permuted_index_.resize(K_.nonZeros());
   for (int c = 0; c < size; ++c) {
     for (int q = outer[c]; q < outer[c + 1]; ++q) {
       const int pr = position[inner[q]], pc = position[c];
       const int slot = next[std::max(pr, pc)]++;
-      permuted_row_[slot] = std::min(pr, pc);
+      (*permuted_row)[slot] = std::min(pr, pc);
       permuted_index_[q] = slot;
     }
   }
@@ -324,8 +327,7 @@ void CertificateMatrix::InitializeDoubleDouble() {
   DoubleDoubleCholesky::Options options;
   options.num_threads = problem_.num_threads();
   extended_ = std::make_unique<DoubleDoubleCholesky>(options);
-  extended_->Analyze(static_cast<int>(K_.rows()), permuted_start_,
-                     permuted_row_);
+  extended_->ShareAnalysis(*double_);
 }
 
 bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,

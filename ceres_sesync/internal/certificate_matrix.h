@@ -126,8 +126,7 @@ class CertificateMatrix {
   double complete_double_seconds() const { return complete_double_seconds_; }
 
   // Factorizations so far, by arithmetic, and the seconds spent in the
-  // double-double ones (including their assembly and symbolic analysis,
-  // unless AnalyzeDoubleDouble() ran it ahead).
+  // double-double ones (including their assembly).
   int double_factorizations() const { return double_factorizations_; }
   int extended_factorizations() const { return extended_factorizations_; }
   double extended_time_s() const { return extended_time_s_; }
@@ -138,14 +137,6 @@ class CertificateMatrix {
   // multiply-add, from the symbolic analysis (deterministic, unlike a
   // measured time).
   double FactorizationCostInSolves(int r) const;
-
-  // The double-double proofs' symbolic analysis (permuted pattern, elimination
-  // tree, supernodes), which the first of them runs otherwise; for running
-  // it ahead, concurrently with work that does not use this object. Not
-  // counted in extended_time_s().
-  void AnalyzeDoubleDouble() {
-    if (!extended_) InitializeDoubleDouble();
-  }
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }
@@ -167,10 +158,12 @@ class CertificateMatrix {
   // The double factorization of K_, counted and timed; true iff it completed.
   bool FactorizeDouble();
   bool ProveDoubleDouble(const Eigen::MatrixXd& Lambda, double c);
-  // K_'s upper triangle permuted by ordering_ (permuted_start_,
-  // permuted_row_), the map of its values (permuted_index_) and position_.
-  void InitializePermutedPattern();
-  // The symbolic analysis of the double-double factor.
+  // K_'s upper triangle permuted by ordering_ in compressed columns (the
+  // factorizations' pattern), the map of its values (permuted_index_) and
+  // position_.
+  void InitializePermutedPattern(std::vector<int>* permuted_start,
+                                 std::vector<int>* permuted_row);
+  // The double-double factor, sharing the double one's symbolic analysis.
   void InitializeDoubleDouble();
   // mu settled when the translation rows' bound `head` met it or not.
   bool SettleShift(double head, double* mu) const;
@@ -183,9 +176,9 @@ class CertificateMatrix {
   std::vector<int> translation_diagonal_;  // Value index of each Lbar_jj.
   std::vector<int> ordering_;  // Fill-reducing: ordering_[k] = k-th pivot.
   std::vector<int> position_;  // Its inverse.
-  // The permuted upper triangle of K_ in compressed columns, and where each
-  // value of K_ goes in it.
-  std::vector<int> permuted_start_, permuted_row_, permuted_index_;
+  // Where each value of K_ goes in the factorizations' permuted upper
+  // triangle.
+  std::vector<int> permuted_index_;
   // Rounding of the stored data matrices, per row of K.
   std::vector<double> data_rounding_;
   // The double factorizations (same scheme as the double-double proofs,

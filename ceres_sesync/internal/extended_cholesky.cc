@@ -531,107 +531,124 @@ bool FactorSupernode(const Kernels& kernels, int nrows, int ncols, double* hi,
 
 DoubleDoubleCholesky::DoubleDoubleCholesky(const Options& options)
     : options_(options),
-      vectorized_(options.supernodal && options.vectorize && HaveAvx2()) {}
+      vectorized_(options.supernodal && options.vectorize && HaveAvx2()),
+      symbolic_(std::make_shared<const Symbolic>()) {}
 
 void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
                                    std::vector<int> row_index) {
-  n_ = n;
-  column_start_ = std::move(column_start);
-  row_index_ = std::move(row_index);
-  CHECK_EQ(static_cast<int>(column_start_.size()), n + 1);
+  auto fresh = std::make_shared<Symbolic>();
+  Symbolic& sym = *fresh;
+  sym.n = n;
+  sym.column_start = std::move(column_start);
+  sym.row_index = std::move(row_index);
+  CHECK_EQ(static_cast<int>(sym.column_start.size()), n + 1);
   // Elimination tree (Liu's algorithm with path compression through
   // `ancestor`).
-  parent_.assign(n, -1);
+  sym.parent.assign(n, -1);
   std::vector<int> ancestor(n, -1);
   for (int k = 0; k < n; ++k) {
-    for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
-      for (int i = row_index_[p]; i != -1 && i < k;) {
+    for (int p = sym.column_start[k]; p < sym.column_start[k + 1]; ++p) {
+      for (int i = sym.row_index[p]; i != -1 && i < k;) {
         const int next = ancestor[i];
         ancestor[i] = k;
-        if (next == -1) parent_[i] = k;
+        if (next == -1) sym.parent[i] = k;
         i = next;
       }
     }
   }
   // Column counts of L by one symbolic up-looking pass (every row's reach).
   std::vector<int> count(n, 1), mark(n, -1);
-  row_count_.assign(n, 1);
+  sym.row_count.assign(n, 1);
   for (int k = 0; k < n; ++k) {
     mark[k] = k;
-    for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
-      for (int i = row_index_[p]; mark[i] != k; i = parent_[i]) {
+    for (int p = sym.column_start[k]; p < sym.column_start[k + 1]; ++p) {
+      for (int i = sym.row_index[p]; mark[i] != k; i = sym.parent[i]) {
         mark[i] = k;
         ++count[i];
-        ++row_count_[k];
+        ++sym.row_count[k];
       }
     }
   }
-  factor_start_.assign(n + 1, 0);
-  flops_ = 0;
+  sym.factor_start.assign(n + 1, 0);
+  sym.flops = 0;
   for (int k = 0; k < n; ++k) {
-    factor_start_[k + 1] = factor_start_[k] + count[k];
-    flops_ += 0.5 * count[k] * static_cast<double>(count[k]);
+    sym.factor_start[k + 1] = sym.factor_start[k] + count[k];
+    sym.flops += 0.5 * count[k] * static_cast<double>(count[k]);
   }
+  if (options_.supernodal) AnalyzeSupernodes(options_, &sym);
+  SetSymbolic(std::move(fresh));
+}
+
+void DoubleDoubleCholesky::ShareAnalysis(const DoubleDoubleCholesky& other) {
+  CHECK(!other.symbolic_->column_start.empty()) << "no analysis to share";
+  CHECK(options_.supernodal && other.options_.supernodal)
+      << "only supernodal analyses are shared";
+  CHECK_EQ(options_.min_split_flops, other.options_.min_split_flops);
+  SetSymbolic(other.symbolic_);
+}
+
+void DoubleDoubleCholesky::SetSymbolic(std::shared_ptr<const Symbolic> sym) {
+  symbolic_ = std::move(sym);
   // The simplicial factorization fills L's rows and values; the supernodal
   // one keeps L in its dense blocks instead, with the rows per supernode.
-  factor_row_.assign(options_.supernodal ? 0 : factor_start_[n], 0);
-  factor_value_.assign(options_.supernodal ? 0 : factor_start_[n],
-                       DoubleDouble());
+  const int entries = options_.supernodal ? 0 : symbolic_->factor_start.back();
+  factor_row_.assign(entries, 0);
+  factor_value_.assign(entries, DoubleDouble());
   super_hi_.clear();
   super_lo_.clear();
   factorized_ = false;
-  super_start_.clear();
-  super_row_start_.clear();
-  super_row_.clear();
-  super_value_start_.clear();
-  if (options_.supernodal) AnalyzeSupernodes();
 }
 
-void DoubleDoubleCholesky::AnalyzeSupernodes() {
-  const int n = n_;
+void DoubleDoubleCholesky::AnalyzeSupernodes(const Options& options,
+                                             Symbolic* symbolic) {
+  Symbolic& sym = *symbolic;
+  const int n = sym.n;
   // A's lower triangle by columns: the values of column i of L (entries
-  // (k, i), k >= i), by column (scatter_start_), with their rows.
-  scatter_start_.assign(n + 1, 0);
+  // (k, i), k >= i), by column (sym.scatter_start), with their rows.
+  sym.scatter_start.assign(n + 1, 0);
   for (int k = 0; k < n; ++k) {
-    for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
-      ++scatter_start_[row_index_[p] + 1];
+    for (int p = sym.column_start[k]; p < sym.column_start[k + 1]; ++p) {
+      ++sym.scatter_start[sym.row_index[p] + 1];
     }
   }
-  for (int i = 0; i < n; ++i) scatter_start_[i + 1] += scatter_start_[i];
-  std::vector<int> lower_row(row_index_.size());
-  scatter_source_.resize(row_index_.size());
+  for (int i = 0; i < n; ++i) sym.scatter_start[i + 1] += sym.scatter_start[i];
+  std::vector<int> lower_row(sym.row_index.size());
+  sym.scatter_source.resize(sym.row_index.size());
   {
-    std::vector<int> next(scatter_start_.begin(), scatter_start_.end() - 1);
+    std::vector<int> next(sym.scatter_start.begin(),
+                          sym.scatter_start.end() - 1);
     for (int k = 0; k < n; ++k) {
-      for (int p = column_start_[k]; p < column_start_[k + 1]; ++p) {
-        const int slot = next[row_index_[p]]++;
+      for (int p = sym.column_start[k]; p < sym.column_start[k + 1]; ++p) {
+        const int slot = next[sym.row_index[p]]++;
         lower_row[slot] = k;
-        scatter_source_[slot] = p;
+        sym.scatter_source[slot] = p;
       }
     }
   }
   // Fundamental supernodes: column j + 1 continues column j's supernode iff
   // it is j's parent and has j's pattern minus j (then their counts differ
   // by one: the pattern of j minus j is contained in its parent's).
-  auto count = [&](int j) { return factor_start_[j + 1] - factor_start_[j]; };
-  super_start_.push_back(0);
+  auto count = [&](int j) {
+    return sym.factor_start[j + 1] - sym.factor_start[j];
+  };
+  sym.super_start.push_back(0);
   for (int j = 1; j < n; ++j) {
-    if (!(parent_[j - 1] == j && count(j - 1) == count(j) + 1)) {
-      super_start_.push_back(j);
+    if (!(sym.parent[j - 1] == j && count(j - 1) == count(j) + 1)) {
+      sym.super_start.push_back(j);
     }
   }
-  if (n > 0) super_start_.push_back(n);
-  const int num_super = num_supernodes();
-  column_super_.resize(n);
+  if (n > 0) sym.super_start.push_back(n);
+  const int num_super = static_cast<int>(sym.super_start.size()) - 1;
+  sym.column_super.resize(n);
   for (int s = 0; s < num_super; ++s) {
-    for (int j = super_start_[s]; j < super_start_[s + 1]; ++j) {
-      column_super_[j] = s;
+    for (int j = sym.super_start[s]; j < sym.super_start[s + 1]; ++j) {
+      sym.column_super[j] = s;
     }
   }
   std::vector<int> super_parent(num_super, -1);
   for (int s = 0; s < num_super; ++s) {
-    const int up = parent_[super_start_[s + 1] - 1];
-    if (up >= 0) super_parent[s] = column_super_[up];
+    const int up = sym.parent[sym.super_start[s + 1] - 1];
+    if (up >= 0) super_parent[s] = sym.column_super[up];
   }
   // The rows of each supernode, without forming L's pattern column by
   // column: its columns, then the rows below them of A's columns in it and
@@ -650,45 +667,46 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
     }
   }
   long long total_rows = 0;
-  for (int s = 0; s < num_super; ++s) total_rows += count(super_start_[s]);
-  super_row_.reserve(total_rows);
+  for (int s = 0; s < num_super; ++s) total_rows += count(sym.super_start[s]);
+  sym.super_row.reserve(total_rows);
   std::vector<int> mark(n, -1);
-  super_row_start_.assign(1, 0);
-  super_value_start_.assign(1, 0);
+  sym.super_row_start.assign(1, 0);
+  sym.super_value_start.assign(1, 0);
   for (int s = 0; s < num_super; ++s) {
-    const int first = super_start_[s], last = super_start_[s + 1];
+    const int first = sym.super_start[s], last = sym.super_start[s + 1];
     const int ncols = last - first;
     for (int j = first; j < last; ++j) {
       mark[j] = s;
-      super_row_.push_back(j);
+      sym.super_row.push_back(j);
     }
-    const size_t below = super_row_.size();
+    const size_t below = sym.super_row.size();
     for (int j = first; j < last; ++j) {
-      for (int q = scatter_start_[j]; q < scatter_start_[j + 1]; ++q) {
+      for (int q = sym.scatter_start[j]; q < sym.scatter_start[j + 1]; ++q) {
         const int k = lower_row[q];
         if (mark[k] != s) {
           mark[k] = s;
-          super_row_.push_back(k);
+          sym.super_row.push_back(k);
         }
       }
     }
     for (int c = child_head[s]; c != -1; c = child_next[c]) {
-      const int c_cols = super_start_[c + 1] - super_start_[c];
-      for (int t = super_row_start_[c] + c_cols; t < super_row_start_[c + 1];
-           ++t) {
-        const int k = super_row_[t];
+      const int c_cols = sym.super_start[c + 1] - sym.super_start[c];
+      for (int t = sym.super_row_start[c] + c_cols;
+           t < sym.super_row_start[c + 1]; ++t) {
+        const int k = sym.super_row[t];
         if (mark[k] != s) {
           mark[k] = s;
-          super_row_.push_back(k);
+          sym.super_row.push_back(k);
         }
       }
     }
-    std::sort(super_row_.begin() + below, super_row_.end());
-    super_row_start_.push_back(static_cast<int>(super_row_.size()));
-    const long long nrows = super_row_start_[s + 1] - super_row_start_[s];
+    std::sort(sym.super_row.begin() + below, sym.super_row.end());
+    sym.super_row_start.push_back(static_cast<int>(sym.super_row.size()));
+    const long long nrows = sym.super_row_start[s + 1] - sym.super_row_start[s];
     CHECK_EQ(nrows, count(first)) << "supernode " << s << ": its rows and "
                                   << "the column count disagree";
-    super_value_start_.push_back(super_value_start_.back() + nrows * ncols);
+    sym.super_value_start.push_back(sym.super_value_start.back() +
+                                    nrows * ncols);
   }
   // The split for parallel factorization (tree_split.h), weighted by the
   // work each supernode's factorization step does: left-looking, column j's
@@ -698,19 +716,19 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
   // position t, from each of its columns at or left of t: (t + 1) (nrows - t)
   // for s itself (t < ncols), ncols (nrows - t) for the supernode of a row
   // below. (Integers: the sums are exact in any order.)
-  super_bin_.clear();
-  if (flops_ >= options_.min_split_flops) {
+  sym.super_bin.clear();
+  if (sym.flops >= options.min_split_flops) {
     std::vector<double> work(num_super, 0.0);
     for (int s = 0; s < num_super; ++s) {
-      const int ncols = super_start_[s + 1] - super_start_[s];
-      const int begin = super_row_start_[s];
-      const int nrows = super_row_start_[s + 1] - begin;
+      const int ncols = sym.super_start[s + 1] - sym.super_start[s];
+      const int begin = sym.super_row_start[s];
+      const int nrows = sym.super_row_start[s + 1] - begin;
       for (int t = 0; t < nrows; ++t) {
         const double remaining = nrows - t;
         if (t < ncols) {
           work[s] += (t + 1.0) * remaining;
         } else {
-          work[column_super_[super_row_[begin + t]]] += ncols * remaining;
+          work[sym.column_super[sym.super_row[begin + t]]] += ncols * remaining;
         }
       }
     }
@@ -719,24 +737,24 @@ void DoubleDoubleCholesky::AnalyzeSupernodes() {
     VLOG(2) << "double-double factorization: top " << split.top_weight << " of "
             << split.total_weight << " multiply-adds, heaviest bin "
             << split.heaviest_bin << (split.bin.empty() ? " (not split)" : "");
-    super_bin_ = split.bin;
+    sym.super_bin = split.bin;
   }
   // Where each input value goes: entry (k, i), k >= i, of A is in column i
-  // of L, in supernode s = column_super_[i], at the position of row k. Each
+  // of L, in supernode s = sym.column_super[i], at the position of row k. Each
   // column is filled by the thread that factors it, right before its
   // updates (FactorizeSupernodal).
-  scatter_destination_.resize(row_index_.size());
+  sym.scatter_destination.resize(sym.row_index.size());
   std::vector<int> position(n, -1);
   for (int s = 0; s < num_super; ++s) {
-    const int first = super_start_[s];
-    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
-    const int* rows = super_row_.data() + super_row_start_[s];
+    const int first = sym.super_start[s];
+    const int nrows = sym.super_row_start[s + 1] - sym.super_row_start[s];
+    const int* rows = sym.super_row.data() + sym.super_row_start[s];
     for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
-    for (int j = first; j < super_start_[s + 1]; ++j) {
-      for (int q = scatter_start_[j]; q < scatter_start_[j + 1]; ++q) {
-        scatter_destination_[q] = super_value_start_[s] +
-                                  static_cast<long long>(j - first) * nrows +
-                                  position[lower_row[q]];
+    for (int j = first; j < sym.super_start[s + 1]; ++j) {
+      for (int q = sym.scatter_start[j]; q < sym.scatter_start[j + 1]; ++q) {
+        sym.scatter_destination[q] = sym.super_value_start[s] +
+                                     static_cast<long long>(j - first) * nrows +
+                                     position[lower_row[q]];
       }
     }
   }
@@ -746,6 +764,7 @@ template <typename Value>
 bool DoubleDoubleCholesky::FactorizeSupernodal(
     const std::vector<Value>& values,
     std::chrono::steady_clock::time_point deadline) {
+  const Symbolic& sym = *symbolic_;
   constexpr bool kExtended = std::is_same_v<Value, DoubleDouble>;
   const int num_super = num_supernodes();
   const Kernels kernels =
@@ -775,30 +794,30 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   // s_lo) and scatters A's values into them.
   auto fill_columns = [&](int s, int c0, int c1, int nrows, double* s_hi,
                           double* s_lo) {
-    const int first = super_start_[s];
+    const int first = sym.super_start[s];
     std::fill(s_hi + static_cast<long long>(c0) * nrows,
               s_hi + static_cast<long long>(c1) * nrows, 0.0);
     if constexpr (kExtended) {
       std::fill(s_lo + static_cast<long long>(c0) * nrows,
                 s_lo + static_cast<long long>(c1) * nrows, 0.0);
     }
-    for (int q = scatter_start_[first + c0]; q < scatter_start_[first + c1];
-         ++q) {
+    for (int q = sym.scatter_start[first + c0];
+         q < sym.scatter_start[first + c1]; ++q) {
       if constexpr (kExtended) {
         // Renormalized (the same value): the kernels' bounds assume it.
-        const DoubleDouble& value = values[scatter_source_[q]];
+        const DoubleDouble& value = values[sym.scatter_source[q]];
         const DoubleDouble v = dd::TwoSum(value.hi, value.lo);
-        super_hi[scatter_destination_[q]] = v.hi;
-        super_lo[scatter_destination_[q]] = v.lo;
+        super_hi[sym.scatter_destination[q]] = v.hi;
+        super_lo[sym.scatter_destination[q]] = v.lo;
       } else {
-        super_hi[scatter_destination_[q]] = values[scatter_source_[q]];
+        super_hi[sym.scatter_destination[q]] = values[sym.scatter_source[q]];
       }
     }
   };
   // Left-looking: supernode d, once factored, waits in the list of the
   // supernode holding its next row below the ones already applied
   // (pointer[d]), which it updates when that one's turn comes. With a split
-  // (super_bin_), each bin keeps lists of its own (a bin's supernodes
+  // (sym.super_bin), each bin keeps lists of its own (a bin's supernodes
   // update only their ancestors: in the bin or in the top), which are
   // joined, in bin order, for the top's turn.
   const int num_bins = this->num_bins();
@@ -820,12 +839,12 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
   // updated in: splitting one update into column ranges changes nothing.
   auto update = [&](int d, int p1, int p2, const std::vector<int>& position,
                     double* s_hi, double* s_lo, int nrows, Scratch* scratch) {
-    const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
-    const int* d_rows = super_row_.data() + super_row_start_[d];
+    const int d_nrows = sym.super_row_start[d + 1] - sym.super_row_start[d];
+    const int* d_rows = sym.super_row.data() + sym.super_row_start[d];
     const int m = d_nrows - p1, n = p2 - p1;
-    const double* d_hi = super_hi.data() + super_value_start_[d] + p1;
-    const double* d_lo = lo(super_lo.data(), super_value_start_[d] + p1);
-    const int k = super_start_[d + 1] - super_start_[d];
+    const double* d_hi = super_hi.data() + sym.super_value_start[d] + p1;
+    const double* d_lo = lo(super_lo.data(), sym.super_value_start[d] + p1);
+    const int k = sym.super_start[d + 1] - sym.super_start[d];
     // The target rows of d's rows p1.. are contiguous in s (positions
     // increase with the rows): update s in place; otherwise gather the
     // target entries, update, scatter.
@@ -873,37 +892,37 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       }
     }
   };
-  // Factors the supernodes s with super_bin_[s] == bin (all if unsplit) in
+  // Factors the supernodes s with sym.super_bin[s] == bin (all if unsplit) in
   // increasing order, with the lists `head`, on `threads` threads: wide
   // supernodes (the top separators, which receive most updates) take their
   // updates in column ranges, one per thread. False if stopped or on a
   // failed pivot (which stops the other bins too).
   auto factor = [&](int bin, std::vector<int>* head_list, int threads) {
     std::vector<int>& head = *head_list;
-    std::vector<int> position(n_, -1), list;
+    std::vector<int> position(sym.n, -1), list;
     std::vector<Scratch> scratch(threads);
     for (int s = 0; s < num_super; ++s) {
-      if (num_bins > 0 && super_bin_[s] != bin) continue;
+      if (num_bins > 0 && sym.super_bin[s] != bin) continue;
       if (stop.load(std::memory_order_relaxed)) return false;
       if (has_deadline && std::chrono::steady_clock::now() > deadline) {
         timed_out = true;
         stop = true;
         return false;
       }
-      const int first = super_start_[s], last = super_start_[s + 1];
+      const int first = sym.super_start[s], last = sym.super_start[s + 1];
       const int ncols = last - first;
-      const int nrows = super_row_start_[s + 1] - super_row_start_[s];
-      const int* rows = super_row_.data() + super_row_start_[s];
-      double* s_hi = super_hi.data() + super_value_start_[s];
-      double* s_lo = lo(super_lo.data(), super_value_start_[s]);
+      const int nrows = sym.super_row_start[s + 1] - sym.super_row_start[s];
+      const int* rows = sym.super_row.data() + sym.super_row_start[s];
+      double* s_hi = super_hi.data() + sym.super_value_start[s];
+      double* s_lo = lo(super_lo.data(), sym.super_value_start[s]);
       for (int t = 0; t < nrows; ++t) position[rows[t]] = t;
       // The updates: supernode d's rows p1 = pointer[d] .. p2 - 1 are in
       // s's columns.
       list.clear();
       for (int d = head[s]; d != -1; d = next[d]) list.push_back(d);
       auto rows_in_s = [&](int d) {
-        const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
-        const int* d_rows = super_row_.data() + super_row_start_[d];
+        const int d_nrows = sym.super_row_start[d + 1] - sym.super_row_start[d];
+        const int* d_rows = sym.super_row.data() + sym.super_row_start[d];
         int p2 = pointer[d];
         while (p2 < d_nrows && d_rows[p2] < last) ++p2;
         return p2;
@@ -924,7 +943,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
         const int c0 = column_begin(part), c1 = column_begin(part + 1);
         fill_columns(s, c0, c1, nrows, s_hi, s_lo);
         for (int d : list) {
-          const int* d_rows = super_row_.data() + super_row_start_[d];
+          const int* d_rows = sym.super_row.data() + sym.super_row_start[d];
           const int p1 = pointer[d], p2 = rows_in_s(d);
           const int q1 =
               std::lower_bound(d_rows + p1, d_rows + p2, first + c0) - d_rows;
@@ -938,12 +957,12 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       // Each d waits next for the supernode of its first row beyond s.
       head[s] = -1;
       for (int d : list) {
-        const int d_nrows = super_row_start_[d + 1] - super_row_start_[d];
-        const int* d_rows = super_row_.data() + super_row_start_[d];
+        const int d_nrows = sym.super_row_start[d + 1] - sym.super_row_start[d];
+        const int* d_rows = sym.super_row.data() + sym.super_row_start[d];
         const int p2 = rows_in_s(d);
         pointer[d] = p2;
         if (p2 < d_nrows) {
-          const int target = column_super_[d_rows[p2]];
+          const int target = sym.column_super[d_rows[p2]];
           next[d] = head[target];
           head[target] = d;
         }
@@ -954,7 +973,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
       }
       pointer[s] = ncols;
       if (ncols < nrows) {
-        const int target = column_super_[rows[ncols]];
+        const int target = sym.column_super[rows[ncols]];
         next[s] = head[target];
         head[target] = s;
       }
@@ -975,7 +994,7 @@ bool DoubleDoubleCholesky::FactorizeSupernodal(
     // waiting in a bin's lists waits for a top supernode).
     std::vector<int>& top_head = heads[num_bins];
     for (int s = num_super - 1; ok && s >= 0; --s) {
-      if (super_bin_[s] != -1) continue;
+      if (sym.super_bin[s] != -1) continue;
       for (int b = num_bins - 1; b >= 0; --b) {
         int d = heads[b][s];
         if (d == -1) continue;
@@ -1015,8 +1034,9 @@ template <typename Value>
 bool DoubleDoubleCholesky::FactorizeValues(
     const std::vector<Value>& values,
     std::chrono::steady_clock::time_point deadline) {
+  const Symbolic& sym = *symbolic_;
   constexpr bool kExtended = std::is_same_v<Value, DoubleDouble>;
-  CHECK_EQ(values.size(), row_index_.size());
+  CHECK_EQ(values.size(), sym.row_index.size());
   timed_out_ = false;
   extended_factor_ = kExtended;
   for (const Value& v : values) {
@@ -1024,11 +1044,11 @@ bool DoubleDoubleCholesky::FactorizeValues(
   }
   if constexpr (kExtended) {
     if (!options_.supernodal) {
-      std::vector<int> fill(n_);
-      factorized_ =
-          FactorizeRows(n_, column_start_.data(), row_index_.data(),
-                        values.data(), parent_.data(), factor_start_.data(),
-                        factor_row_.data(), factor_value_.data(), fill.data());
+      std::vector<int> fill(sym.n);
+      factorized_ = FactorizeRows(
+          sym.n, sym.column_start.data(), sym.row_index.data(), values.data(),
+          sym.parent.data(), sym.factor_start.data(), factor_row_.data(),
+          factor_value_.data(), fill.data());
       return factorized_;
     }
   } else {
@@ -1040,21 +1060,22 @@ bool DoubleDoubleCholesky::FactorizeValues(
 
 void DoubleDoubleCholesky::RowBackwardErrorBounds(
     std::vector<double>* rho) const {
+  const Symbolic& sym = *symbolic_;
   CHECK(factorized_);
   // v_i = sum_j (|L| |L^T|)_ij = sum_c |L_ic| s_c with s_c the column sums
   // of |L|. Every |L| value is rounded up (AbsUpperBound), and a computed sum
   // of m nonnegative doubles is within gamma_m (double) of the exact one, so
   // the factor (1 + 1e-6) covers the rounding of this computation for up to
   // 10^9 terms (gamma_{10^9} < 1.2e-7).
-  std::vector<double> column_sum(n_, 0.0), v(n_, 0.0);
+  std::vector<double> column_sum(sym.n, 0.0), v(sym.n, 0.0);
   double max_pivot = 1;  // For the underflow term below.
-  for (int c = 0; c < n_; ++c) {
+  for (int c = 0; c < sym.n; ++c) {
     ForEachEntry(c, [&](int row, const DoubleDouble& l) {
       if (row == c) max_pivot = std::max(max_pivot, l.AbsUpperBound());
       column_sum[c] += l.AbsUpperBound();
     });
   }
-  for (int c = 0; c < n_; ++c) {
+  for (int c = 0; c < sym.n; ++c) {
     ForEachEntry(c, [&](int row, const DoubleDouble& l) {
       v[row] += l.AbsUpperBound() * column_sum[c];
     });
@@ -1064,14 +1085,15 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
   // the pivot l_jj it is multiplied with (the backward error of l_ij is
   // l_jj times its forward error).
   const int max_count =
-      n_ > 0 ? *std::max_element(row_count_.begin(), row_count_.end()) : 0;
+      sym.n > 0 ? *std::max_element(sym.row_count.begin(), sym.row_count.end())
+                : 0;
   const double underflow_per_entry =
       (max_count + 2.0) * kUnderflowError * max_pivot * (1 + 1e-6);
-  rho->resize(n_);
-  for (int i = 0; i < n_; ++i) {
+  rho->resize(sym.n);
+  for (int i = 0; i < sym.n; ++i) {
     const double entries =
-        row_count_[i] + (factor_start_[i + 1] - factor_start_[i]);
-    const double m = row_count_[i] + 1;
+        sym.row_count[i] + (sym.factor_start[i + 1] - sym.factor_start[i]);
+    const double m = sym.row_count[i] + 1;
     const double gamma =
         extended_factor_ ? DoubleDoubleGamma(m) : DoubleGamma(m);
     (*rho)[i] = gamma * v[i] * (1 + 1e-6) + entries * underflow_per_entry;
@@ -1079,25 +1101,27 @@ void DoubleDoubleCholesky::RowBackwardErrorBounds(
 }
 
 const HugePageVector<int>& DoubleDoubleCholesky::factor_row() const {
-  if (options_.supernodal && factor_row_.empty() && n_ > 0) {
-    factor_row_.resize(factor_start_[n_]);
-    for (int c = 0; c < n_; ++c) {
-      const int s = column_super_[c], jj = c - super_start_[s];
-      std::copy(super_row_.begin() + super_row_start_[s] + jj,
-                super_row_.begin() + super_row_start_[s + 1],
-                factor_row_.begin() + factor_start_[c]);
+  const Symbolic& sym = *symbolic_;
+  if (options_.supernodal && factor_row_.empty() && sym.n > 0) {
+    factor_row_.resize(sym.factor_start[sym.n]);
+    for (int c = 0; c < sym.n; ++c) {
+      const int s = sym.column_super[c], jj = c - sym.super_start[s];
+      std::copy(sym.super_row.begin() + sym.super_row_start[s] + jj,
+                sym.super_row.begin() + sym.super_row_start[s + 1],
+                factor_row_.begin() + sym.factor_start[c]);
     }
   }
   return factor_row_;
 }
 
 const std::vector<DoubleDouble>& DoubleDoubleCholesky::factor_value() const {
+  const Symbolic& sym = *symbolic_;
   if (options_.supernodal && factorized_ && factor_value_.empty()) {
-    factor_value_.resize(factor_start_[n_]);
-    for (int c = 0; c < n_; ++c) {
+    factor_value_.resize(sym.factor_start[sym.n]);
+    for (int c = 0; c < sym.n; ++c) {
       int t = 0;
       ForEachEntry(c, [&](int, const DoubleDouble& l) {
-        factor_value_[factor_start_[c] + t++] = l;
+        factor_value_[sym.factor_start[c] + t++] = l;
       });
     }
   }
@@ -1107,12 +1131,13 @@ const std::vector<DoubleDouble>& DoubleDoubleCholesky::factor_value() const {
 void DoubleDoubleCholesky::ForEachSupernode(
     const std::function<void(int, int, const int*, int, const double*)>& f)
     const {
+  const Symbolic& sym = *symbolic_;
   CHECK(factorized_ && options_.supernodal);
   for (int s = 0; s < num_supernodes(); ++s) {
-    f(super_start_[s], super_start_[s + 1] - super_start_[s],
-      super_row_.data() + super_row_start_[s],
-      super_row_start_[s + 1] - super_row_start_[s],
-      super_hi_.data() + super_value_start_[s]);
+    f(sym.super_start[s], sym.super_start[s + 1] - sym.super_start[s],
+      sym.super_row.data() + sym.super_row_start[s],
+      sym.super_row_start[s + 1] - sym.super_row_start[s],
+      super_hi_.data() + sym.super_value_start[s]);
   }
 }
 

@@ -46,6 +46,7 @@
 
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "ceres_sesync/internal/double_double.h"
@@ -82,6 +83,10 @@ class DoubleDoubleCholesky {
   // <= k, no duplicates; the diagonal must be present). O(nnz(L)).
   void Analyze(int n, std::vector<int> column_start,
                std::vector<int> row_index);
+  // Uses `other`'s analysis (supernodal, the same min_split_flops) instead
+  // of running Analyze() again on the same pattern: the analysis is
+  // immutable and shared, the numeric factors stay separate. Costs O(1).
+  void ShareAnalysis(const DoubleDoubleCholesky& other);
 
   // Numerical factorization with values[p] the entry row_index[p] of the
   // pattern. Returns false if a pivot is not positive (A is not positive
@@ -119,55 +124,94 @@ class DoubleDoubleCholesky {
   // (permuted order), with the rounding of this computation itself covered.
   void RowBackwardErrorBounds(std::vector<double>* rho) const;
 
-  int size() const { return n_; }
+  int size() const { return symbolic_->n; }
   // Entries of L (after Analyze()).
   long long factor_nonzeros() const {
-    return factor_start_.empty() ? 0 : factor_start_.back();
+    return symbolic_->factor_start.empty() ? 0 : symbolic_->factor_start.back();
   }
   // After a successful Factorize(): L in compressed columns (each column's
   // diagonal first, then its rows in increasing order). The supernodal
   // scheme keeps L in its dense blocks: factor_value() copies it out on its
   // first call after a factorization (for inspection and tests).
-  const std::vector<int>& factor_start() const { return factor_start_; }
+  const std::vector<int>& factor_start() const {
+    return symbolic_->factor_start;
+  }
   // The supernodal scheme keeps L's rows per supernode: factor_row() lists
   // them by column on its first call after Analyze().
   const HugePageVector<int>& factor_row() const;
   const std::vector<DoubleDouble>& factor_value() const;
   // Multiply-adds of one factorization: sum over columns of count^2 / 2.
-  double flops() const { return flops_; }
+  double flops() const { return symbolic_->flops; }
   // After Analyze(), supernodal: the supernodes and their stored entries
   // (dense blocks, including the explicit zeros of merged supernodes and
   // the unused upper triangles of the diagonal blocks).
   // Supernode s holds columns supernode_start()[s] .. [s + 1] - 1.
-  const std::vector<int>& supernode_start() const { return super_start_; }
+  const std::vector<int>& supernode_start() const {
+    return symbolic_->super_start;
+  }
   int num_supernodes() const {
-    return super_start_.empty() ? 0 : static_cast<int>(super_start_.size()) - 1;
+    return symbolic_->super_start.empty()
+               ? 0
+               : static_cast<int>(symbolic_->super_start.size()) - 1;
   }
   long long supernodal_entries() const {
-    return super_value_start_.empty() ? 0 : super_value_start_.back();
+    return symbolic_->super_value_start.empty()
+               ? 0
+               : symbolic_->super_value_start.back();
   }
   // After Analyze(): bins of the parallel factorization (0: not split).
-  int num_bins() const { return super_bin_.empty() ? 0 : kTreeSplitBins; }
+  int num_bins() const {
+    return symbolic_->super_bin.empty() ? 0 : kTreeSplitBins;
+  }
   // Whether Factorize() uses the SIMD kernels.
   bool vectorized() const { return vectorized_; }
 
  private:
-  void AnalyzeSupernodes();
+  // The symbolic analysis: everything Analyze() computes from the pattern,
+  // immutable once built and shared by the objects that factor it
+  // (ShareAnalysis()).
+  struct Symbolic {
+    int n = 0;
+    std::vector<int> column_start, row_index;  // The upper triangle of A.
+    std::vector<int> parent;                   // Elimination tree.
+    std::vector<int> factor_start;             // Column pointers of L.
+    std::vector<int> row_count;                // Entries per row of L.
+    double flops = 0;
+    // Supernodes: columns super_start[s] .. super_start[s+1] - 1, rows
+    // super_row[super_row_start[s] ..] (increasing, its columns first),
+    // values (column-major, leading dimension = its row count) at
+    // super_value_start[s] in the dense blocks of FactorizeSupernodal().
+    std::vector<int> super_start, super_row_start, super_row;
+    std::vector<long long> super_value_start;
+    std::vector<int> column_super;  // Supernode of each column.
+    // Bin of each supernode (-1: top) of the parallel factorization, or
+    // empty.
+    std::vector<int> super_bin;
+    // Input values by the column of L they are in: those of column j are
+    // scatter_source[q] for q in scatter_start[j] .. scatter_start[j+1] - 1,
+    // at block entry scatter_destination[q].
+    std::vector<int> scatter_start, scatter_source;
+    std::vector<long long> scatter_destination;
+  };
+  static void AnalyzeSupernodes(const Options& options, Symbolic* symbolic);
+  // Installs an analysis and drops any numeric factor.
+  void SetSymbolic(std::shared_ptr<const Symbolic> symbolic);
   // f(row, value) for every entry of column c of L in order (the diagonal
   // first), in either layout.
   template <typename F>
   void ForEachEntry(int c, F&& f) const {
+    const Symbolic& sym = *symbolic_;
     if (!options_.supernodal) {
-      for (int p = factor_start_[c]; p < factor_start_[c + 1]; ++p) {
+      for (int p = sym.factor_start[c]; p < sym.factor_start[c + 1]; ++p) {
         f(factor_row_[p], factor_value_[p]);
       }
       return;
     }
-    const int s = column_super_[c], jj = c - super_start_[s];
-    const int* rows = super_row_.data() + super_row_start_[s];
-    const int nrows = super_row_start_[s + 1] - super_row_start_[s];
+    const int s = sym.column_super[c], jj = c - sym.super_start[s];
+    const int* rows = sym.super_row.data() + sym.super_row_start[s];
+    const int nrows = sym.super_row_start[s + 1] - sym.super_row_start[s];
     const long long at =
-        super_value_start_[s] + static_cast<long long>(jj) * nrows;
+        sym.super_value_start[s] + static_cast<long long>(jj) * nrows;
     const double* hi = super_hi_.data() + at;
     if (!extended_factor_) {
       for (int t = jj; t < nrows; ++t) f(rows[t], DoubleDouble(hi[t]));
@@ -186,38 +230,20 @@ class DoubleDoubleCholesky {
 
   Options options_;
   bool vectorized_ = false;
-  int n_ = 0;
-  std::vector<int> column_start_, row_index_;  // The upper triangle of A.
-  std::vector<int> parent_;                    // Elimination tree.
-  std::vector<int> factor_start_;              // Column pointers of L.
+  // Empty until Analyze() or ShareAnalysis().
+  std::shared_ptr<const Symbolic> symbolic_;
   // Row indices of L (simplicial; for the supernodal scheme a copy made by
   // factor_row() on demand).
   mutable HugePageVector<int> factor_row_;
   // Values of L (simplicial; for the supernodal scheme a copy made by
   // factor_value() on demand).
   mutable std::vector<DoubleDouble> factor_value_;
-  // The supernodal scheme's dense blocks (see super_value_start_), which
-  // hold L after a successful factorization.
+  // The supernodal scheme's dense blocks (see Symbolic::super_value_start),
+  // which hold L after a successful factorization.
   HugePageVector<double> super_hi_, super_lo_;
-  std::vector<int> row_count_;  // Entries per row of L.
-  double flops_ = 0;
   bool factorized_ = false;
   bool extended_factor_ = true;  // The last factorization's arithmetic.
   bool timed_out_ = false;
-  // Supernodes: columns super_start_[s] .. super_start_[s+1] - 1, rows
-  // super_row_[super_row_start_[s] ..] (increasing, its columns first), values
-  // (column-major, leading dimension = its row count) at
-  // super_value_start_[s] in the dense blocks of FactorizeSupernodal().
-  std::vector<int> super_start_, super_row_start_, super_row_;
-  std::vector<long long> super_value_start_;
-  std::vector<int> column_super_;  // Supernode of each column.
-  // Bin of each supernode (-1: top) of the parallel factorization, or empty.
-  std::vector<int> super_bin_;
-  // Input values by the column of L they are in: those of column j are
-  // scatter_source_[q] for q in scatter_start_[j] .. scatter_start_[j+1] - 1,
-  // at block entry scatter_destination_[q].
-  std::vector<int> scatter_start_, scatter_source_;
-  std::vector<long long> scatter_destination_;
 };
 
 }  // namespace ceres_sesync::internal

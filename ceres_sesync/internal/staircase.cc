@@ -208,15 +208,13 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     s.message = "the translational Laplacian is not positive definite";
     return;
   }
-  // The certificate matrix's symbolic analysis, the preconditioner's choice
-  // (from that analysis) and construction, and with block-Jacobi the
-  // double-double proof's symbolic analysis. None depends on the initial
-  // point: with a second thread they run while Initialize() computes the
-  // chordal one (which only reads the problem), and Initialize() waits for
-  // them (the wait is counted there). On the 10^5-pose city: the certificate
-  // analysis ~0.45 s, the exact preconditioner's factorization ~2 s, the
-  // double-double analysis ~0.5 s (which large maps, the ones that choose
-  // block-Jacobi, need for their first certificate).
+  // The certificate matrix's symbolic analysis (which its double and
+  // double-double factorizations share), the preconditioner's choice (from
+  // that analysis) and construction. None depends on the initial point:
+  // with a second thread they run while Initialize() computes the chordal
+  // one (which only reads the problem), and Initialize() waits for them
+  // (the wait is counted there). On the 10^5-pose city: the certificate
+  // analysis ~0.45 s, the exact preconditioner's factorization ~2 s.
   const bool parallel_window =
       problem_->num_threads() > 1 &&
       options.initialization == SolverOptions::Initialization::kChordal;
@@ -234,10 +232,6 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
         *problem_, choice.type, options_.regularized_cholesky_max_condition,
         certificate_.get(), choice.settings);
     cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
-    if (parallel_window && choice.type != PreconditionerType::kRegularizedQ &&
-        options_.proof_arithmetic != SolverOptions::ProofArithmetic::kDouble) {
-      certificate_->AnalyzeDoubleDouble();
-    }
   };
   if (parallel_window) {
     setup_pending_ = std::async(std::launch::async, prepare);

@@ -145,8 +145,8 @@ class Staircase {
   // scale_ and zero_objective_ from the problem's current data.
   void SetScales();
   // Waits for the set-up run concurrently with Initialize() (see the
-  // constructor: certificate_, preconditioner_, cost_ and, with
-  // block-Jacobi, the double-double analysis), if it is still running.
+  // constructor: certificate_, preconditioner_ and cost_), if it is still
+  // running.
   void AwaitSetup();
   // Seconds left of options.max_time_s (at least 1 ms), or 0 for no limit.
   double RemainingTime() const;
@@ -192,9 +192,9 @@ class Staircase {
   std::unique_ptr<CertificateMatrix> certificate_;
   std::unique_ptr<SESyncPreconditioner> preconditioner_;
   std::unique_ptr<SESyncCost> cost_;
-  // Builds certificate_, preconditioner_ and cost_ (and runs the
-  // double-double analysis) on another thread (declared after what it uses,
-  // so that it is joined before they are destroyed).
+  // Builds certificate_, preconditioner_ and cost_ on another thread
+  // (declared after what it uses, so that it is joined before they are
+  // destroyed).
   std::future<void> setup_pending_;
   VerificationResult verification_;
   // The lowest-objective rounding of the levels Run() escaped from, and its
