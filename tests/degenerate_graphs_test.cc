@@ -497,6 +497,38 @@ TEST(DegenerateGraphs, ExtremeWeightsGiveACleanStatus) {
   }
 }
 
+// A chain whose translational weights differ by 1e20: Lbar = [[1 + b, -b],
+// [-b, b]] (the gauge pose removed), b = 1e20, is positive definite but
+// its Cholesky factorization cancels to a zero pivot in double in either
+// elimination order. kInvalidInput with the message, on one thread and on
+// two (Lbar then factorized in the background during the chordal
+// initialization), and from a given initial guess.
+TEST(DegenerateGraphs, NumericallySingularTranslationalLaplacianIsAnError) {
+  for (int d : {2, 3}) {
+    PoseGraph g = EmptyGraph(d, 3);
+    const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(d, d);
+    AddEdge(&g, 0, 1, I, Eigen::VectorXd::Ones(d), 1.0, 1.0);
+    AddEdge(&g, 1, 2, I, Eigen::VectorXd::Ones(d), 1.0, 1e20);
+    std::string error;
+    ASSERT_TRUE(ValidatePoseGraph(g, &error)) << error;
+    for (int threads : {1, 2}) {
+      for (bool initial : {false, true}) {
+        SCOPED_TRACE(::testing::Message() << "d=" << d << " threads " << threads
+                                          << " initial " << initial);
+        SolverOptions o;
+        o.num_threads = threads;
+        SolverSummary s;
+        const Poses x =
+            initial ? Solve(g, IdentityPoses(d, 3), o, &s) : Solve(g, o, &s);
+        EXPECT_EQ(s.status, Status::kInvalidInput);
+        EXPECT_EQ(s.message,
+                  "the translational Laplacian is not positive definite");
+        EXPECT_TRUE(x.empty());
+      }
+    }
+  }
+}
+
 TEST(DegenerateGraphs, NoiselessDataIsSolvedExactlyAndCertified) {
   std::mt19937_64 rng(8);
   for (int d : {2, 3}) {

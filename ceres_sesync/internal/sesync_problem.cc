@@ -278,7 +278,7 @@ ProblemLayout::ProblemLayout(const PoseGraph& graph)
 }
 
 SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
-                             MeasurementWeights weights)
+                             MeasurementWeights weights, bool background_lbar)
     : graph_(&graph),
       layout_(graph),
       weights_(std::move(weights)),
@@ -321,10 +321,17 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
   // Supernodal where Lbar's fill is heavy (10^6-pose city: 3.3 s, and the
   // data stage 32.7 -> 25.7 s against simplicial); the products with Q use
   // the extracted copy either way.
-  lbar_factor_ = std::make_unique<CholmodFactor>();
-  ConfigureCholmod(CholmodLayout::kAutomatic, lbar_factor_.get());
-  lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(lbar_ordering));
-  FactorizeLbar();
+  auto factorize = [this, ordering = std::move(lbar_ordering)]() mutable {
+    lbar_factor_ = std::make_unique<CholmodFactor>();
+    ConfigureCholmod(CholmodLayout::kAutomatic, lbar_factor_.get());
+    lbar_factor_->AnalyzePatternWithOrdering(Lbar_, std::move(ordering));
+    FactorizeLbar();
+  };
+  if (background_lbar && num_threads_ > 1) {
+    lbar_pending_ = std::async(std::launch::async, std::move(factorize));
+  } else {
+    factorize();
+  }
 }
 
 void SESyncProblem::Assemble() {
@@ -425,6 +432,7 @@ void SESyncProblem::FactorizeLbar() {
 
 bool SESyncProblem::UpdateWeights(MeasurementWeights weights) {
   CHECK(weights.empty() || weights.size() == graph_->measurements.size());
+  AwaitLbar();
   weights_ = std::move(weights);
   const Eigen::Index nnz_D = D_.nonZeros(), nnz_V = Vbar_.nonZeros(),
                      nnz_L = Lbar_.nonZeros();
@@ -440,6 +448,7 @@ bool SESyncProblem::UpdateWeights(MeasurementWeights weights) {
 
 void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,
                               Eigen::MatrixXd* YQ) const {
+  AwaitLbar();
   MultiplyBySparse(Y, D_, /*accumulate=*/false, num_threads_, YQ);
   if (Lbar_.rows() == 0) return;
   Eigen::MatrixXd P, Z;  // P = Y Vbar^T (r x (n-1)), Z = P Lbar^{-1}.
@@ -449,6 +458,7 @@ void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,
 }
 
 double SESyncProblem::LbarBackwardError() const {
+  AwaitLbar();
   if (Lbar_.rows() == 0) return 0;
   double bound = 0, unused = 0;
   lbar_factor_->BackwardErrorBound(static_cast<int>(Lbar_.rows()), &bound,
@@ -467,6 +477,7 @@ Eigen::MatrixXd SESyncProblem::RecoverTranslations(
   const int N = layout_.num_translations();
   Eigen::MatrixXd T = Eigen::MatrixXd::Zero(d_, N);
   if (N == 1) return T;
+  AwaitLbar();
   const Eigen::MatrixXd rhs = Vbar_ * R.transpose();  // (N-1) x d
   const Eigen::MatrixXd reduced = lbar_factor_->solve(rhs).transpose();
   for (int k = 0; k < N; ++k) {

@@ -28,6 +28,7 @@
 #define CERES_SESYNC_INTERNAL_SESYNC_PROBLEM_H_
 
 #include <complex>
+#include <future>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -349,8 +350,18 @@ class SESyncProblem {
   // factorized. Products with Q use up to `num_threads` threads (results do
   // not depend on it). `weights` (measurement_weights.h; empty: all 1)
   // define the weighted problem; they must pass CheckMeasurementWeights.
+  // With `background_lbar` and num_threads > 1, Lbar's symbolic analysis
+  // and factorization run on another thread after the constructor returns,
+  // and every member that needs the factor (ok(), MultiplyQ(),
+  // RecoverTranslations(), LbarBackwardError(), LbarIsSupernodal(),
+  // UpdateWeights()) waits for it: for a caller with work that needs only
+  // the assembled matrices and the ordering (the chordal initialization).
   explicit SESyncProblem(const PoseGraph& graph, int num_threads = 1,
-                         MeasurementWeights weights = {});
+                         MeasurementWeights weights = {},
+                         bool background_lbar = false);
+  // The background factorization holds `this`.
+  SESyncProblem(SESyncProblem&&) = delete;
+  SESyncProblem& operator=(SESyncProblem&&) = delete;
 
   const PoseGraph& graph() const { return *graph_; }
   // The weights of the problem (empty: all 1).
@@ -366,7 +377,10 @@ class SESyncProblem {
   // returns ok().
   bool UpdateWeights(MeasurementWeights weights);
 
-  bool ok() const { return ok_; }
+  bool ok() const {
+    AwaitLbar();
+    return ok_;
+  }
   int dimension() const { return d_; }
   // The index sets (ProblemLayout). Below, n is num_rotations() (the number
   // of d x d blocks of Q: the poses, plus R_w with priors) and N is
@@ -406,6 +420,7 @@ class SESyncProblem {
   // Whether CHOLMOD chose the supernodal layout for Lbar's factor (heavy
   // fill: large maps, 3D lattices).
   bool LbarIsSupernodal() const {
+    AwaitLbar();
     return lbar_factor_ != nullptr && lbar_factor_->IsSupernodal();
   }
 
@@ -427,6 +442,10 @@ class SESyncProblem {
   void Assemble();
   // Numeric factorization of Lbar (symbolic analysis done); sets ok_.
   void FactorizeLbar();
+  // Waits for a background factorization of Lbar, if one is running.
+  void AwaitLbar() const {
+    if (lbar_pending_.valid()) lbar_pending_.wait();
+  }
 
   const PoseGraph* graph_ = nullptr;
   ProblemLayout layout_;
@@ -438,6 +457,9 @@ class SESyncProblem {
   std::unique_ptr<CholmodFactor> lbar_factor_;
   SparseCholeskyFactor lbar_solver_;  // The same factor, for MultiplyQ.
   std::vector<int> vertex_ordering_;
+  // The background factorization of Lbar (declared last: destroyed, i.e.
+  // joined, first).
+  std::shared_future<void> lbar_pending_;
 };
 
 // tr(Lambda) = sum_i tr(Lambda_i) for the d x d blocks of Lambda (d x dn).

@@ -20,6 +20,9 @@
 namespace ceres_sesync::internal {
 namespace {
 
+constexpr char kLbarNotPositiveDefinite[] =
+    "the translational Laplacian is not positive definite";
+
 PreconditionerType ToInternal(SolverOptions::Preconditioner p) {
   switch (p) {
     case SolverOptions::Preconditioner::kNone:
@@ -201,24 +204,28 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
 
   Progress("data");
   const auto t = Clock::now();
-  problem_ = std::make_unique<SESyncProblem>(
-      graph, ResolveNumThreads(options.num_threads), std::move(weights));
-  if (!problem_->ok()) {
+  // Lbar's factorization, the certificate matrix's symbolic analysis (which
+  // its double and double-double factorizations share), the
+  // preconditioner's choice (from that analysis) and construction. None
+  // depends on the initial point: with a second thread they run while
+  // Initialize() computes the chordal one (which needs only the assembled
+  // matrices and the ordering), and Initialize() waits for them (the wait is
+  // counted there). On the 10^6-pose city, two threads: Lbar ~4.8 s, the
+  // certificate's analysis ~6 s, the chordal initialization ~11 s.
+  const int num_threads = ResolveNumThreads(options.num_threads);
+  const bool parallel_window =
+      num_threads > 1 &&
+      options.initialization == SolverOptions::Initialization::kChordal;
+  problem_ =
+      std::make_unique<SESyncProblem>(graph, num_threads, std::move(weights),
+                                      /*background_lbar=*/parallel_window);
+  if (!parallel_window && !problem_->ok()) {
     s.status = SolverSummary::Status::kInvalidInput;
-    s.message = "the translational Laplacian is not positive definite";
+    s.message = kLbarNotPositiveDefinite;
     return;
   }
-  // The certificate matrix's symbolic analysis (which its double and
-  // double-double factorizations share), the preconditioner's choice (from
-  // that analysis) and construction. None depends on the initial point:
-  // with a second thread they run while Initialize() computes the chordal
-  // one (which only reads the problem), and Initialize() waits for them
-  // (the wait is counted there). On the 10^5-pose city: the certificate
-  // analysis ~0.45 s, the exact preconditioner's factorization ~2 s.
-  const bool parallel_window =
-      problem_->num_threads() > 1 &&
-      options.initialization == SolverOptions::Initialization::kChordal;
-  auto prepare = [this, parallel_window] {
+  auto prepare = [this] {
+    if (!problem_->ok()) return;  // Initialize() reports it.
     certificate_ = std::make_unique<CertificateMatrix>(*problem_);
     const PreconditionerChoice choice =
         ChoosePreconditioner(options_, *certificate_, r0_);
@@ -283,7 +290,7 @@ bool Staircase::Reweight(MeasurementWeights weights, Clock::time_point start) {
   const auto t = Clock::now();
   if (!problem_->UpdateWeights(std::move(weights))) {
     s.status = SolverSummary::Status::kInvalidInput;
-    s.message = "the translational Laplacian is not positive definite";
+    s.message = kLbarNotPositiveDefinite;
     return false;
   }
   certificate_->Refresh();
@@ -370,6 +377,12 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
     Y->topRows(d) = R;
   }
   AwaitSetup();
+  if (!problem_->ok()) {  // Lbar's factorization ran in the background.
+    s.status = SolverSummary::Status::kInvalidInput;
+    s.message = kLbarNotPositiveDefinite;
+    ok_ = false;
+    return false;
+  }
   s.initialization_time_s =
       std::chrono::duration<double>(Clock::now() - t).count();
   return true;
