@@ -261,6 +261,23 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   EXPECT_EQ(u.factorizations, 0);
   EXPECT_EQ(u.extended_factorizations, 1);
   EXPECT_EQ(u.precision, internal::ProofPrecision::kDoubleDouble);
+  // The same with the near-optimality test in double first (as the
+  // staircase asks on large maps: test_in_double_first): one double
+  // factorization at eta_max more, the same double-double proof.
+  internal::VerificationOptions hinted_first = hinted;
+  hinted_first.test_in_double_first = true;
+  internal::CertificateMatrix fresh_first(problem);
+  const internal::VerificationResult u_first =
+      internal::VerifyCertificate(problem, Lambda, hinted_first, &fresh_first);
+  ASSERT_TRUE(u_first.certified);
+  EXPECT_LE(u_first.eta, options.eta_goal);
+  EXPECT_EQ(reference.NegativePivots(Lambda, u_first.eta), 0)
+      << "FALSE CERTIFICATE: S + eta I is indefinite (eta " << u_first.eta
+      << ")";
+  EXPECT_GE(u_first.eta, true_shift);
+  EXPECT_EQ(u_first.factorizations, 1);
+  EXPECT_EQ(u_first.extended_factorizations, 1);
+  EXPECT_EQ(u_first.precision, internal::ProofPrecision::kDoubleDouble);
 
   // Teeth: multipliers raised by delta make lambda_min(S') =
   // lambda_min(S) - delta. Within the goal (delta = goal / 2) the proof must
@@ -361,6 +378,26 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   const double deep_lambda_min = -(true_shift + deep_delta);
   EXPECT_LE(t.direction_curvature, 0.99 * deep_lambda_min);
   EXPECT_GE(t.direction_curvature, 1.001 * deep_lambda_min);
+
+  // The same saddle with the near-optimality test in double first: the
+  // failed double-double proof becomes a failed double factorization at
+  // eta_max, and the candidate is taken for a saddle as after it (the
+  // ladder's first shift, the witness, the tightening as above).
+  internal::CertificateMatrix first_matrix(problem);
+  internal::VerificationOptions deeper_first = deeper;
+  deeper_first.test_in_double_first = true;
+  const internal::VerificationResult t_first =
+      internal::VerifyCertificate(problem, deep, deeper_first, &first_matrix);
+  EXPECT_FALSE(t_first.certified);
+  EXPECT_FALSE(t_first.vacuous_bound);
+  EXPECT_EQ(t_first.extended_factorizations, 0);
+  EXPECT_EQ(t_first.factorizations, 3);
+  ASSERT_TRUE(std::isfinite(t_first.eta));
+  EXPECT_EQ(reference.NegativePivots(deep, t_first.eta), 0)
+      << "FALSE CERTIFICATE at eta " << t_first.eta;
+  EXPECT_LT(t_first.eta, 64 * deeper.eta_max);
+  EXPECT_LE(t_first.direction_curvature, 0.99 * deep_lambda_min);
+  EXPECT_GE(t_first.direction_curvature, 1.001 * deep_lambda_min);
 
   // As the staircase calls it below its top rank (tighten_uncertified
   // false): the witness alone, from a looser Lanczos tolerance, one

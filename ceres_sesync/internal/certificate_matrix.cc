@@ -92,6 +92,10 @@ double CertificateMatrix::FactorizationCostInSolves(int r) const {
          (4.0 * r * std::max<double>(1, double_->factor_nonzeros()));
 }
 
+double CertificateMatrix::factorization_flops() const {
+  return double_->flops();
+}
+
 bool CertificateMatrix::supernodal() const {
   return 2 * double_->flops() >=
          kSupernodalSwitch * std::max<double>(1, double_->factor_nonzeros());

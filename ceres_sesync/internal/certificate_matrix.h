@@ -137,6 +137,8 @@ class CertificateMatrix {
   // multiply-add, from the symbolic analysis (deterministic, unlike a
   // measured time).
   double FactorizationCostInSolves(int r) const;
+  // Multiply-adds of one factorization (sum over columns of count^2 / 2).
+  double factorization_flops() const;
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }

@@ -323,7 +323,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
         result.eta <= goal) {
       return finish();
     }
-  } else if (options.likely_optimal) {
+  } else if (options.likely_optimal && !options.test_in_double_first) {
     // Double cannot reach the goal; a probably optimal candidate goes to
     // double-double directly (see VerificationOptions::likely_optimal).
     if (attempt(goal / 16) && result.eta <= goal) return finish();
@@ -344,6 +344,9 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   if (!near_optimal && !suspect_saddle && eta_max > eta_target &&
       fits(matrix->PredictedSeconds(ProofPrecision::kDouble))) {
     near_optimal = factor_at_eta_max = matrix->Factorize(Lambda, eta_max);
+    // A likely optimal candidate that is not near-optimal: a lifted saddle
+    // (as after a failed double-double proof above).
+    suspect_saddle = !near_optimal && options.likely_optimal;
   }
   if (result.out_of_time) return finish();
   // 3. Near-optimal: tighten the proof.

@@ -37,19 +37,26 @@ struct VerificationOptions {
   double translation_spread = 0;
   // The candidate is probably optimal (the caller's evidence: the staircase
   // sets it when rounding Y loses at most the goal; a lifted saddle of rank
-  // d passes that test too, and then pays the failed proof below). Where double
-  // cannot reach the goal (its floor, see translation_spread, is above it) and
-  // kAutomatic escalates to double-double, the double-double proof at goal / 16
-  // is then tried first, before the near-optimality test in double (one double
-  // factorization at eta_max), which is needed only if that proof fails. A
-  // certified large map then takes one double-double factorization instead of
-  // it plus a double one; a candidate that is not near-optimal costs one failed
-  // double-double factorization more (1.6-1.7x a double one, measured). When
-  // that proof fails, the candidate is taken for a lifted saddle: the
-  // near-optimality test is skipped, and the witness's ladder proves its
-  // first shift (64 eta_max) before the poor-candidate test (two
-  // factorizations fewer for a saddle; one more for a poor candidate).
+  // d passes that test too). Where double cannot reach the goal (its floor,
+  // see translation_spread, is above it) and kAutomatic escalates to
+  // double-double, the double-double proof at goal / 16 is then tried first,
+  // before the near-optimality test in double (one double factorization at
+  // eta_max), which is needed only if that proof fails: a certified map
+  // takes one double-double factorization instead of it plus a double one,
+  // a lifted saddle one failed double-double factorization more (~4.6
+  // double ones on large maps). When that proof fails, the candidate is
+  // taken for a lifted saddle: the near-optimality test is skipped, and the
+  // witness's ladder proves its first shift (64 eta_max) before the
+  // poor-candidate test (two factorizations fewer for a saddle; one more for
+  // a poor candidate).
   bool likely_optimal = false;
+  // With likely_optimal: the near-optimality test in double comes first all
+  // the same, and when it fails the candidate is taken for a lifted saddle
+  // (as after a failed double-double proof). That costs a certified
+  // candidate one double factorization and saves a saddle ~3.6 (a failed
+  // double-double one minus the test): it pays where more than ~1 in 5
+  // candidates are saddles, which the staircase expects of large maps.
+  bool test_in_double_first = false;
   // When not certified: prove a last shift just above the Lanczos estimate
   // of lambda_min(S) (one more factorization), so that eta and its lower
   // bound are near what lambda_min allows instead of at the witness's
