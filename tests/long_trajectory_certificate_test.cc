@@ -364,40 +364,35 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   const Eigen::MatrixXd deep = raise(deep_delta);
   ASSERT_LT(256 * deeper.eta_max,
             internal::BlockDiagonalTrace(deep, c.d) / deep.cols());
-  const internal::VerificationResult t =
-      internal::VerifyCertificate(problem, deep, deeper, &deep_matrix);
-  EXPECT_FALSE(t.certified);
-  EXPECT_FALSE(t.vacuous_bound);
-  EXPECT_EQ(t.extended_factorizations, 1);
-  EXPECT_EQ(t.factorizations, 2);
-  ASSERT_TRUE(std::isfinite(t.eta));
-  EXPECT_EQ(reference.NegativePivots(deep, t.eta), 0)
-      << "FALSE CERTIFICATE at eta " << t.eta;
-  EXPECT_LT(t.eta, 64 * deeper.eta_max);  // Tightened below the witness's.
   // lambda_min(S') = lambda_min(S) - deep_delta, to ReferenceShift's 1e-3.
   const double deep_lambda_min = -(true_shift + deep_delta);
-  EXPECT_LE(t.direction_curvature, 0.99 * deep_lambda_min);
-  EXPECT_GE(t.direction_curvature, 1.001 * deep_lambda_min);
-
+  // The deep saddle's verification with `o`: not certified, `extended` and
+  // `factorizations` factorizations, a sound proof tightened below the
+  // witness's shift, the witness's curvature at lambda_min(S').
+  auto check_deep_saddle = [&](const internal::VerificationOptions& o,
+                               int extended, int factorizations) {
+    internal::CertificateMatrix m(problem);
+    const internal::VerificationResult t =
+        internal::VerifyCertificate(problem, deep, o, &m);
+    EXPECT_FALSE(t.certified);
+    EXPECT_FALSE(t.vacuous_bound);
+    EXPECT_EQ(t.extended_factorizations, extended);
+    EXPECT_EQ(t.factorizations, factorizations);
+    ASSERT_TRUE(std::isfinite(t.eta));
+    EXPECT_EQ(reference.NegativePivots(deep, t.eta), 0)
+        << "FALSE CERTIFICATE at eta " << t.eta;
+    EXPECT_LT(t.eta, 64 * deeper.eta_max);  // Tightened below the witness's.
+    EXPECT_LE(t.direction_curvature, 0.99 * deep_lambda_min);
+    EXPECT_GE(t.direction_curvature, 1.001 * deep_lambda_min);
+  };
+  check_deep_saddle(deeper, 1, 2);
   // The same saddle with the near-optimality test in double first: the
   // failed double-double proof becomes a failed double factorization at
   // eta_max, and the candidate is taken for a saddle as after it (the
   // ladder's first shift, the witness, the tightening as above).
-  internal::CertificateMatrix first_matrix(problem);
   internal::VerificationOptions deeper_first = deeper;
   deeper_first.test_in_double_first = true;
-  const internal::VerificationResult t_first =
-      internal::VerifyCertificate(problem, deep, deeper_first, &first_matrix);
-  EXPECT_FALSE(t_first.certified);
-  EXPECT_FALSE(t_first.vacuous_bound);
-  EXPECT_EQ(t_first.extended_factorizations, 0);
-  EXPECT_EQ(t_first.factorizations, 3);
-  ASSERT_TRUE(std::isfinite(t_first.eta));
-  EXPECT_EQ(reference.NegativePivots(deep, t_first.eta), 0)
-      << "FALSE CERTIFICATE at eta " << t_first.eta;
-  EXPECT_LT(t_first.eta, 64 * deeper.eta_max);
-  EXPECT_LE(t_first.direction_curvature, 0.99 * deep_lambda_min);
-  EXPECT_GE(t_first.direction_curvature, 1.001 * deep_lambda_min);
+  check_deep_saddle(deeper_first, 0, 3);
 
   // As the staircase calls it below its top rank (tighten_uncertified
   // false): the witness alone, from a looser Lanczos tolerance, one
