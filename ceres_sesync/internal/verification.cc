@@ -344,9 +344,11 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   if (!near_optimal && !suspect_saddle && eta_max > eta_target &&
       fits(matrix->PredictedSeconds(ProofPrecision::kDouble))) {
     near_optimal = factor_at_eta_max = matrix->Factorize(Lambda, eta_max);
-    // A likely optimal candidate that is not near-optimal: a lifted saddle
-    // (as after a failed double-double proof above).
-    suspect_saddle = !near_optimal && options.likely_optimal;
+    // Tested in double first (test_in_double_first): a likely optimal
+    // candidate that is not near-optimal is a lifted saddle, as after a
+    // failed double-double proof above.
+    suspect_saddle =
+        !near_optimal && options.likely_optimal && options.test_in_double_first;
   }
   if (result.out_of_time) return finish();
   // 3. Near-optimal: tighten the proof.
