@@ -174,21 +174,23 @@ struct SolverOptions {
   // levels entered by an escape test the certificate during their
   // optimization: one factorization of S + eta I, eta half the tolerance's
   // shift (certification_max_relative_bound * F(Y) / (2 d n)), in double
-  // where double can prove it, else double-double, whenever the
-  // Hessian-vector products since the last test number at least twice a
-  // factorization's cost in products (the symbolic analysis's flop count,
-  // a double-double test priced at 1.5 double ones; not a time, so results
-  // do not depend on the machine's load or the thread count) and a quarter
-  // of the level's products so far (the 10^6-pose city: certified after
-  // 173-175 rank-5 products; with half, 175 or 491 on two trajectories that
-  // differ in round-off: a test's outcome near the tolerance is marginal). The
-  // level stops at the first test that passes; its proof stands, and the
-  // level's verification tightens it in double where double reaches below it.
+  // where double can prove it, else double-double (but where double reaches
+  // three quarters of the shift, as on maps of ~10^6 poses, in double at the
+  // smallest shift it reaches, on the double-double test's schedule),
+  // whenever the Hessian-vector products since the last test number at
+  // least twice a factorization's cost in products (the symbolic analysis's
+  // flop count, a double-double test priced at 1.5 double ones; not a time,
+  // so results do not depend on the machine's load or the thread count) and
+  // a quarter of the level's products so far (the 10^6-pose city: certified
+  // after 173-175 rank-5 products; with half, 175 or 491 on two trajectories
+  // that differ in round-off: a test's outcome near the tolerance is
+  // marginal). The level stops at the first test that passes; its proof
+  // stands, and the level's verification tightens it in double where double
+  // reaches at least 2x below it.
   // The returned poses are the same (rounding refines them to the same local
   // optimum); the proven bound is within the tolerance but can be looser than
-  // after a converged descent (large maps, where only double-double reaches it:
-  // about half the tolerance). Off: every level runs to the local solver's
-  // tests.
+  // after a converged descent (large maps: half to three quarters of the
+  // tolerance). Off: every level runs to the local solver's tests.
   bool test_certificate_after_escape = true;
 
   // Threads for the products with Q, the triangular solves (two subtrees of

@@ -442,6 +442,34 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   EXPECT_LT(k.eta, 2 * known_delta);
   EXPECT_EQ(reference.NegativePivots(near, k.eta), 0)
       << "FALSE CERTIFICATE at eta " << k.eta;
+
+  // A known shift within 2x of what double reaches (1.5 floors; a descent's
+  // test proven at double's reach, internal::PlanDescentTest) is not
+  // tightened: the factor and the Lanczos estimate would cost about three
+  // factorizations for less than a 2x tighter bound. Just above 2x the
+  // tightening runs (a factor at the known shift and the estimate; here its
+  // ladder's first shift, above -lambda_min by what the translation shift
+  // costs, is not below the known one, so nothing tighter is proven).
+  internal::CertificateMatrix at_reach_matrix(problem);
+  const double reach = 1.5 * at_reach_matrix.next_double_shift() * spread;
+  known.known_shift = 1.9 * reach;
+  ASSERT_EQ(reference.NegativePivots(near, known.known_shift), 0);
+  const internal::VerificationResult r =
+      internal::VerifyCertificate(problem, near, known, &at_reach_matrix);
+  EXPECT_TRUE(r.certified);
+  EXPECT_EQ(r.factorizations, 0);
+  EXPECT_EQ(r.extended_factorizations, 0);
+  EXPECT_EQ(r.eta, known.known_shift);
+  internal::CertificateMatrix above_matrix(problem);
+  known.known_shift = 2.1 * reach;
+  ASSERT_EQ(reference.NegativePivots(near, known.known_shift), 0);
+  const internal::VerificationResult a =
+      internal::VerifyCertificate(problem, near, known, &above_matrix);
+  EXPECT_TRUE(a.certified);
+  EXPECT_GE(a.factorizations, 1);
+  EXPECT_LE(a.eta, known.known_shift);
+  EXPECT_EQ(reference.NegativePivots(near, a.eta), 0)
+      << "FALSE CERTIFICATE at eta " << a.eta;
 }
 
 INSTANTIATE_TEST_SUITE_P(Corridors, LongTrajectoryCertificate,

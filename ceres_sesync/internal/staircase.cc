@@ -128,6 +128,27 @@ RiemannianTrustRegionOptions TrustRegionOptions(const SolverOptions& options) {
 
 }  // namespace
 
+DescentTestPlan PlanDescentTest(double half_shift, double three_quarters_shift,
+                                double double_reach,
+                                SolverOptions::ProofArithmetic arithmetic) {
+  using Arithmetic = SolverOptions::ProofArithmetic;
+  DescentTestPlan test;
+  test.eta = half_shift;
+  if (arithmetic != Arithmetic::kDoubleDouble && double_reach <= half_shift) {
+    return test;  // In double at half the tolerance's shift.
+  }
+  // Double-double's price from here on, whichever arithmetic runs.
+  test.price = 1.5;
+  if (arithmetic != Arithmetic::kDoubleDouble &&
+      double_reach <= three_quarters_shift) {
+    test.eta = double_reach;
+    return test;
+  }
+  test.run = arithmetic != Arithmetic::kDouble;
+  test.precision = ProofPrecision::kDoubleDouble;
+  return test;
+}
+
 Solution ToSolutionInGauge(const PoseGraph& graph, const Eigen::MatrixXd& R,
                            const Eigen::MatrixXd& T) {
   const ProblemLayout layout(graph);
@@ -403,23 +424,6 @@ double Staircase::Shift(double relative_bound, double sdp_value) const {
                   relative_bound * sdp_value / (static_cast<double>(d_) * n_));
 }
 
-bool Staircase::CertificateTestArithmetic(double eta,
-                                          ProofPrecision* precision) const {
-  *precision = ProofPrecision::kDouble;
-  if (options_.proof_arithmetic ==
-      SolverOptions::ProofArithmetic::kDoubleDouble) {
-    *precision = ProofPrecision::kDoubleDouble;
-  } else if (1.5 * certificate_->next_double_shift() * translation_spread_ >
-             eta) {
-    // Double cannot prove a shift this small here (see Verify()).
-    if (options_.proof_arithmetic == SolverOptions::ProofArithmetic::kDouble) {
-      return false;
-    }
-    *precision = ProofPrecision::kDoubleDouble;
-  }
-  return true;
-}
-
 bool Staircase::TestCertificate(double eta, ProofPrecision precision,
                                 SolverSummary::Level* level) {
   const Clock::time_point deadline = Deadline();
@@ -522,10 +526,12 @@ void Staircase::Optimize(int rank, bool test_certificate,
     }
     if (!test_during) return true;
     level_products += products;
-    const double eta =
-        Shift(0.5 * options_.certification_max_relative_bound, f);
-    ProofPrecision precision;
-    if (!CertificateTestArithmetic(eta, &precision)) return true;
+    const double tolerance = options_.certification_max_relative_bound;
+    const DescentTestPlan test = PlanDescentTest(
+        Shift(0.5 * tolerance, f), Shift(0.75 * tolerance, f),
+        1.5 * certificate_->next_double_shift() * translation_spread_,
+        options_.proof_arithmetic);
+    if (!test.run) return true;
     // Due when the products since the last test cost at least twice a
     // factorization (so tests cost at most about half the optimization)
     // and number at least a quarter of the level's (a long descent is
@@ -549,13 +555,13 @@ void Staircase::Optimize(int rank, bool test_certificate,
     // level's nominal rank, as calibrated; a level run on fewer nonzero rows
     // (above) does fewer solves per product, so its tests come sooner in time
     // than the rule says.
-    const double cost = certificate_->FactorizationCostInSolves(rank) *
-                        (precision == ProofPrecision::kDouble ? 1.0 : 1.5);
+    const double cost =
+        certificate_->FactorizationCostInSolves(rank) * test.price;
     const int since = level_products - last_test_products;
     if (since < std::max(2 * cost, 0.25 * level_products)) return true;
     last_test_products = level_products;
     const auto test_start = Clock::now();
-    const bool passed = TestCertificate(eta, precision, level);
+    const bool passed = TestCertificate(test.eta, test.precision, level);
     test_seconds +=
         std::chrono::duration<double>(Clock::now() - test_start).count();
     level->certificate_test_passed = passed;

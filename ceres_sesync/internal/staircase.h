@@ -161,10 +161,6 @@ class Staircase {
   // The shift of a relative bound on the objective: relative_bound *
   // sdp_value / (d n), at least min_relative_eta's floor.
   double Shift(double relative_bound, double sdp_value) const;
-  // The arithmetic of a certificate test at shift eta: double where it can
-  // succeed (above the double floor of the last verification), else
-  // double-double; false if the options allow neither.
-  bool CertificateTestArithmetic(double eta, ProofPrecision* precision) const;
   // One certificate test at the current point of the cost: tries to prove
   // S + eta I >= 0 (not started if predicted to end after the time limit).
   // Adds its factorizations to `level`; true iff it proved it.
@@ -222,6 +218,30 @@ class Staircase {
   double passed_test_shift_ = 0;
   ProofPrecision passed_test_precision_ = ProofPrecision::kDouble;
 };
+
+// A certificate test during the descent of a level entered by an escape
+// (SolverOptions::test_certificate_after_escape): its shift, its arithmetic
+// and its price in double factorizations for the tests' schedule
+// (Staircase::Optimize). At half the tolerance's shift (`half_shift`, that
+// of certification_max_relative_bound / 2), in double (price 1) where
+// double can prove it (`double_reach`, 1.5 times the double floor of the
+// last verification: see VerifyCertificate), else in double-double (price
+// 1.5). Where double cannot prove half the tolerance's shift but can prove
+// `three_quarters_shift`, the test is in double at double_reach instead:
+// a double-double factorization costs ~4.6 double ones (10^6-pose city: 45-49
+// s against ~10 s; its reach is at 0.64 of the tolerance's shift), and the
+// bound keeps a quarter of the tolerance to spare. That test keeps the
+// double-double test's schedule (price 1.5). `run` is false where the
+// arithmetic allows no test (kDouble beyond double's reach).
+struct DescentTestPlan {
+  bool run = true;
+  double eta = 0;
+  ProofPrecision precision = ProofPrecision::kDouble;
+  double price = 1;
+};
+DescentTestPlan PlanDescentTest(double half_shift, double three_quarters_shift,
+                                double double_reach,
+                                SolverOptions::ProofArithmetic arithmetic);
 
 // The solution from rotations R (d x dn) and translations T (d x N) in the
 // index sets of ProblemLayout, expressed in the documented gauge. With priors:

@@ -283,16 +283,19 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   };
   if (std::isfinite(options.known_shift)) {
     // Proven already (VerificationOptions::known_shift). Where double can
-    // prove smaller shifts, tighten as in step 3: a factor at the known
-    // shift, the Lanczos estimate of lambda_min(S), double proofs from just
-    // above it (plus what their translation shift costs) up by 8, and, if
-    // they stop short of a 4x tighter shift that the estimate allows
-    // (double's floor), one double-double proof there.
+    // prove shifts at least 2x smaller, tighten as in step 3: a factor at
+    // the known shift, the Lanczos estimate of lambda_min(S), double proofs
+    // from just above it (plus what their translation shift costs) up by 8,
+    // and, if they stop short of a 4x tighter shift that the estimate allows
+    // (double's floor), one double-double proof there. (Closer to the floor
+    // the factorization and Lanczos would cost about three factorizations
+    // for less than a 2x tighter bound: a test proven at the floor itself,
+    // Staircase::DescentTest, is not repeated.)
     result.eta = options.known_shift;
     result.precision = options.known_precision;
     const double start = std::max(
         {eta_target, 1.5 * double_floor, std::numeric_limits<double>::min()});
-    if (first == ProofPrecision::kDouble && start < result.eta &&
+    if (first == ProofPrecision::kDouble && start < 0.5 * result.eta &&
         fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
         matrix->Factorize(Lambda, result.eta)) {
       const double lambda_min = estimate_lambda_min(result.eta);
