@@ -423,18 +423,22 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   // factorizations, and a shift within 2x of -lambda_min. Starting 10%
   // above the estimate (2.2 floors) failed there, and the ladder's next
   // shift, 8x higher, was the result (three factorizations).
-  internal::CertificateMatrix known_matrix(problem);
-  const double floor = known_matrix.next_double_shift() * spread;
+  const double floor =
+      internal::CertificateMatrix(problem).next_double_shift() * spread;
   const double known_delta = 2 * floor + true_shift;
   const Eigen::MatrixXd near = raise(known_delta);
   internal::VerificationOptions known = hinted;
   known.policy = internal::ProofPolicy::kDouble;
   known.likely_optimal = false;
   known.eta_max = 128 * floor;
-  known.known_shift = 64 * floor;
-  ASSERT_EQ(reference.NegativePivots(near, known.known_shift), 0);
-  const internal::VerificationResult k =
-      internal::VerifyCertificate(problem, near, known, &known_matrix);
+  // The verification of `near` with S' + shift I proven (a fresh matrix).
+  auto verify_known = [&](double shift) {
+    known.known_shift = shift;
+    EXPECT_EQ(reference.NegativePivots(near, shift), 0) << "not proven";
+    internal::CertificateMatrix matrix(problem);
+    return internal::VerifyCertificate(problem, near, known, &matrix);
+  };
+  const internal::VerificationResult k = verify_known(64 * floor);
   EXPECT_TRUE(k.certified);
   EXPECT_EQ(k.factorizations, 2);
   EXPECT_EQ(k.extended_factorizations, 0);
@@ -450,24 +454,16 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   // tightening runs (a factor at the known shift and the estimate; here its
   // ladder's first shift, above -lambda_min by what the translation shift
   // costs, is not below the known one, so nothing tighter is proven).
-  internal::CertificateMatrix at_reach_matrix(problem);
-  const double reach = 1.5 * at_reach_matrix.next_double_shift() * spread;
-  known.known_shift = 1.9 * reach;
-  ASSERT_EQ(reference.NegativePivots(near, known.known_shift), 0);
-  const internal::VerificationResult r =
-      internal::VerifyCertificate(problem, near, known, &at_reach_matrix);
+  const double reach = 1.5 * floor;
+  const internal::VerificationResult r = verify_known(1.9 * reach);
   EXPECT_TRUE(r.certified);
   EXPECT_EQ(r.factorizations, 0);
   EXPECT_EQ(r.extended_factorizations, 0);
-  EXPECT_EQ(r.eta, known.known_shift);
-  internal::CertificateMatrix above_matrix(problem);
-  known.known_shift = 2.1 * reach;
-  ASSERT_EQ(reference.NegativePivots(near, known.known_shift), 0);
-  const internal::VerificationResult a =
-      internal::VerifyCertificate(problem, near, known, &above_matrix);
+  EXPECT_EQ(r.eta, 1.9 * reach);
+  const internal::VerificationResult a = verify_known(2.1 * reach);
   EXPECT_TRUE(a.certified);
   EXPECT_GE(a.factorizations, 1);
-  EXPECT_LE(a.eta, known.known_shift);
+  EXPECT_LE(a.eta, 2.1 * reach);
   EXPECT_EQ(reference.NegativePivots(near, a.eta), 0)
       << "FALSE CERTIFICATE at eta " << a.eta;
 }

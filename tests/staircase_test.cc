@@ -17,15 +17,19 @@ using Arithmetic = SolverOptions::ProofArithmetic;
 
 constexpr double kHalf = 2e-4, kThreeQuarters = 3e-4;
 
+void ExpectTest(const DescentTestPlan& t, double eta, ProofPrecision precision,
+                double price) {
+  EXPECT_TRUE(t.run);
+  EXPECT_EQ(t.eta, eta);
+  EXPECT_EQ(t.precision, precision);
+  EXPECT_EQ(t.price, price);
+}
+
 TEST(PlanDescentTest, DoubleAtHalfTheToleranceWhereDoubleReachesIt) {
   for (Arithmetic a : {Arithmetic::kAutomatic, Arithmetic::kDouble}) {
     for (double reach : {0.0, 1e-9, kHalf}) {
-      const DescentTestPlan t =
-          PlanDescentTest(kHalf, kThreeQuarters, reach, a);
-      EXPECT_TRUE(t.run);
-      EXPECT_EQ(t.eta, kHalf);
-      EXPECT_EQ(t.precision, ProofPrecision::kDouble);
-      EXPECT_EQ(t.price, 1.0);
+      ExpectTest(PlanDescentTest(kHalf, kThreeQuarters, reach, a), kHalf,
+                 ProofPrecision::kDouble, 1.0);
     }
   }
 }
@@ -36,35 +40,25 @@ TEST(PlanDescentTest, DoubleAtHalfTheToleranceWhereDoubleReachesIt) {
 TEST(PlanDescentTest, DoubleAtItsReachUpToThreeQuartersOfTheTolerance) {
   for (Arithmetic a : {Arithmetic::kAutomatic, Arithmetic::kDouble}) {
     for (double reach : {1.0001 * kHalf, 2.5e-4, kThreeQuarters}) {
-      const DescentTestPlan t =
-          PlanDescentTest(kHalf, kThreeQuarters, reach, a);
-      EXPECT_TRUE(t.run);
-      EXPECT_EQ(t.eta, reach);
-      EXPECT_EQ(t.precision, ProofPrecision::kDouble);
-      EXPECT_EQ(t.price, 1.5);
+      ExpectTest(PlanDescentTest(kHalf, kThreeQuarters, reach, a), reach,
+                 ProofPrecision::kDouble, 1.5);
     }
   }
 }
 
 TEST(PlanDescentTest, DoubleDoubleAtHalfBeyondDoublesReach) {
   const double reach = 1.0001 * kThreeQuarters;
-  const DescentTestPlan automatic =
-      PlanDescentTest(kHalf, kThreeQuarters, reach, Arithmetic::kAutomatic);
-  EXPECT_TRUE(automatic.run);
-  EXPECT_EQ(automatic.eta, kHalf);
-  EXPECT_EQ(automatic.precision, ProofPrecision::kDoubleDouble);
-  EXPECT_EQ(automatic.price, 1.5);
+  ExpectTest(
+      PlanDescentTest(kHalf, kThreeQuarters, reach, Arithmetic::kAutomatic),
+      kHalf, ProofPrecision::kDoubleDouble, 1.5);
   // Double only: no test can succeed there, none is run.
   EXPECT_FALSE(
       PlanDescentTest(kHalf, kThreeQuarters, reach, Arithmetic::kDouble).run);
   // Double-double only: always at half, whatever double reaches.
   for (double r : {0.0, 2.5e-4, reach}) {
-    const DescentTestPlan t =
-        PlanDescentTest(kHalf, kThreeQuarters, r, Arithmetic::kDoubleDouble);
-    EXPECT_TRUE(t.run);
-    EXPECT_EQ(t.eta, kHalf);
-    EXPECT_EQ(t.precision, ProofPrecision::kDoubleDouble);
-    EXPECT_EQ(t.price, 1.5);
+    ExpectTest(
+        PlanDescentTest(kHalf, kThreeQuarters, r, Arithmetic::kDoubleDouble),
+        kHalf, ProofPrecision::kDoubleDouble, 1.5);
   }
 }
 

@@ -290,7 +290,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     // (double's floor), one double-double proof there. (Closer to the floor
     // the factorization and Lanczos would cost about three factorizations
     // for less than a 2x tighter bound: a test proven at the floor itself,
-    // Staircase::DescentTest, is not repeated.)
+    // PlanDescentTest in staircase.h, is not repeated.)
     result.eta = options.known_shift;
     result.precision = options.known_precision;
     const double start = std::max(

@@ -67,8 +67,9 @@ struct VerificationOptions {
   // known_precision (a certificate test during the optimization: see
   // SolverOptions::test_certificate_after_escape). The result starts from
   // it, and only VerifyCertificate's known-shift tightening tries to improve
-  // on it (no double-double proof repeats the test's cost unless double
-  // stops 4x short of the Lanczos estimate).
+  // on it, where double reaches at least 2x below it (no double-double proof
+  // repeats the test's cost unless double stops 4x short of the Lanczos
+  // estimate).
   double known_shift = std::numeric_limits<double>::infinity();
   ProofPrecision known_precision = ProofPrecision::kDouble;
   // No factorization is started that is predicted to end after this
