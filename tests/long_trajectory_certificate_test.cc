@@ -245,39 +245,36 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   internal::VerificationOptions hinted = options;
   hinted.translation_spread = spread;
   hinted.likely_optimal = true;
-  internal::CertificateMatrix fresh(problem);
-  const bool double_too_coarse =
-      fresh.next_double_shift() * spread > options.eta_goal / 4;
-  const internal::VerificationResult u =
-      internal::VerifyCertificate(problem, Lambda, hinted, &fresh);
-  ASSERT_TRUE(u.certified);
-  EXPECT_LE(u.eta, options.eta_goal);
-  EXPECT_EQ(reference.NegativePivots(Lambda, u.eta), 0)
-      << "FALSE CERTIFICATE: S + eta I is indefinite (eta " << u.eta << ")";
-  EXPECT_GE(u.eta, true_shift);
+  // The translation shift a fresh matrix's first double proof starts with.
+  const double first_double_shift =
+      internal::CertificateMatrix(problem).next_double_shift();
   // The premise (corridors kilometres long): double's floor is above the
   // goal.
-  EXPECT_TRUE(double_too_coarse);
-  EXPECT_EQ(u.factorizations, 0);
-  EXPECT_EQ(u.extended_factorizations, 1);
-  EXPECT_EQ(u.precision, internal::ProofPrecision::kDoubleDouble);
+  EXPECT_GT(first_double_shift * spread, options.eta_goal / 4);
+  // The verification with `o`: certified within the goal, sound, not below
+  // the true shift, by one double-double proof after `factorizations`
+  // double ones.
+  auto check_hinted = [&](const internal::VerificationOptions& o,
+                          int factorizations) {
+    internal::CertificateMatrix fresh(problem);
+    const internal::VerificationResult u =
+        internal::VerifyCertificate(problem, Lambda, o, &fresh);
+    ASSERT_TRUE(u.certified);
+    EXPECT_LE(u.eta, options.eta_goal);
+    EXPECT_EQ(reference.NegativePivots(Lambda, u.eta), 0)
+        << "FALSE CERTIFICATE: S + eta I is indefinite (eta " << u.eta << ")";
+    EXPECT_GE(u.eta, true_shift);
+    EXPECT_EQ(u.factorizations, factorizations);
+    EXPECT_EQ(u.extended_factorizations, 1);
+    EXPECT_EQ(u.precision, internal::ProofPrecision::kDoubleDouble);
+  };
+  check_hinted(hinted, 0);
   // The same with the near-optimality test in double first (as the
   // staircase asks on large maps: test_in_double_first): one double
   // factorization at eta_max more, the same double-double proof.
   internal::VerificationOptions hinted_first = hinted;
   hinted_first.test_in_double_first = true;
-  internal::CertificateMatrix fresh_first(problem);
-  const internal::VerificationResult u_first =
-      internal::VerifyCertificate(problem, Lambda, hinted_first, &fresh_first);
-  ASSERT_TRUE(u_first.certified);
-  EXPECT_LE(u_first.eta, options.eta_goal);
-  EXPECT_EQ(reference.NegativePivots(Lambda, u_first.eta), 0)
-      << "FALSE CERTIFICATE: S + eta I is indefinite (eta " << u_first.eta
-      << ")";
-  EXPECT_GE(u_first.eta, true_shift);
-  EXPECT_EQ(u_first.factorizations, 1);
-  EXPECT_EQ(u_first.extended_factorizations, 1);
-  EXPECT_EQ(u_first.precision, internal::ProofPrecision::kDoubleDouble);
+  check_hinted(hinted_first, 1);
 
   // Teeth: multipliers raised by delta make lambda_min(S') =
   // lambda_min(S) - delta. Within the goal (delta = goal / 2) the proof must
@@ -423,8 +420,7 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   // factorizations, and a shift within 2x of -lambda_min. Starting 10%
   // above the estimate (2.2 floors) failed there, and the ladder's next
   // shift, 8x higher, was the result (three factorizations).
-  const double floor =
-      internal::CertificateMatrix(problem).next_double_shift() * spread;
+  const double floor = first_double_shift * spread;
   const double known_delta = 2 * floor + true_shift;
   const Eigen::MatrixXd near = raise(known_delta);
   internal::VerificationOptions known = hinted;
