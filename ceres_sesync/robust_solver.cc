@@ -233,6 +233,10 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
       !std::isfinite(o.gnc_relative_gradient_tolerance)) {
     return "gnc_relative_gradient_tolerance must be a finite number >= 0";
   }
+  if (!(o.gnc_relative_decrease_tolerance >= 0 &&
+        o.gnc_relative_decrease_tolerance < 1)) {
+    return "gnc_relative_decrease_tolerance must be in [0, 1)";
+  }
   if (o.gnc_threshold_fractions.empty()) {
     return "gnc_threshold_fractions must not be empty";
   }
@@ -342,11 +346,11 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
 
   // The first solve is Solve() itself up to initial_max_rank. GNC's
   // weighted solves then stop their local searches at
-  // gnc_relative_gradient_tolerance, prove their certificates in double
-  // only (they decide saddle escapes; no bound of theirs is reported) and
-  // climb to gnc_max_rank, with no certificate test there; each final
-  // inlier problem is solved with the caller's options again. The
-  // Staircase reads its options at every stage.
+  // gnc_relative_gradient_tolerance or gnc_relative_decrease_tolerance, prove
+  // their certificates in double only (they decide saddle escapes; no bound of
+  // theirs is reported) and climb to gnc_max_rank, with no certificate test
+  // there; each final inlier problem is solved with the caller's options again.
+  // The Staircase reads its options at every stage.
   SolverOptions solve_options = options.solver_options;
   // Gives the next solve the time left (options.max_time_s) and says whether
   // any is left. solve_options.max_time_s is the caller's per-solve limit
@@ -480,6 +484,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     if (options.gnc_relative_gradient_tolerance > 0) {
       solve_options.relative_preconditioned_gradient_tolerance =
           options.gnc_relative_gradient_tolerance;
+    }
+    if (options.gnc_relative_decrease_tolerance > 0) {
+      solve_options.relative_decrease_tolerance =
+          options.gnc_relative_decrease_tolerance;
     }
     solve_options.max_rank = std::min(
         options.solver_options.max_rank,

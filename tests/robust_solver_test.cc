@@ -268,6 +268,43 @@ TEST(RobustSolver, GncStepsStopAtGncMaxRankWithoutTheTopCertificateTest) {
   }
 }
 
+// gnc_relative_decrease_tolerance (its default) ends the GNC steps' local
+// searches earlier than the caller's 1e-12 and touches nothing after GNC:
+// the verdicts and the certified inlier optimum are those of the tight
+// steps.
+TEST(RobustSolver, GncStepsStopAtTheirRelativeDecreaseTolerance) {
+  for (int d : {2, 3}) {
+    PoseGraph corrupted;
+    std::vector<int> added;
+    ASSERT_TRUE(NoisyChainWithOutliers(d, &corrupted, &added));
+    auto steps_iterations = [](const RobustSolverSummary& s) {
+      int iterations = 0;
+      for (const RobustSolverSummary::Iteration& step : s.history) {
+        iterations += step.solver_iterations;
+      }
+      return iterations;
+    };
+    RobustSolverOptions options = Options();
+    options.gnc_relative_decrease_tolerance = 0;  // The caller's 1e-12.
+    RobustSolverSummary tight;
+    SolveRobust(corrupted, options, &tight);
+    options.gnc_relative_decrease_tolerance =
+        RobustSolverOptions().gnc_relative_decrease_tolerance;
+    RobustSolverSummary loose;
+    SolveRobust(corrupted, options, &loose);
+    for (const RobustSolverSummary* s : {&tight, &loose}) {
+      ASSERT_EQ(s->status, RobustSolverSummary::Status::kConverged)
+          << s->FullReport();
+      EXPECT_EQ(s->outlier_edges, added) << s->FullReport();
+      EXPECT_TRUE(s->certified()) << s->FullReport();
+    }
+    EXPECT_LT(steps_iterations(loose), steps_iterations(tight)) << "d = " << d;
+    EXPECT_NEAR(loose.inlier_summary.objective, tight.inlier_summary.objective,
+                1e-10 * tight.inlier_summary.objective)
+        << "d = " << d;
+  }
+}
+
 // max_time_s limits the whole robust solve. Out of time during GNC: status
 // kTimeLimit, not certified, the poses and verdicts of where it stopped;
 // with time to spare: the result of the unlimited solve.
@@ -658,6 +695,13 @@ TEST(RobustSolver, InvalidOptionsAndInputsAreReported) {
     options.readmission_min_scale = scale;
     SolveRobust(graph, options, &s);
     EXPECT_THAT(s.message, ::testing::HasSubstr("readmission_min_scale"));
+  }
+  for (double tolerance : {-1e-3, 1.0, std::nan("")}) {
+    options = Options();
+    options.gnc_relative_decrease_tolerance = tolerance;
+    SolveRobust(graph, options, &s);
+    EXPECT_THAT(s.message,
+                ::testing::HasSubstr("gnc_relative_decrease_tolerance"));
   }
   PoseGraph bad = graph;
   bad.measurements[3].kappa = -1;

@@ -988,6 +988,8 @@ void BindRobust(py::module_& m) {
       .rw("gnc_max_rank", &O::gnc_max_rank)
       .rw("gnc_relative_gradient_tolerance",
           &O::gnc_relative_gradient_tolerance)
+      .rw("gnc_relative_decrease_tolerance",
+          &O::gnc_relative_decrease_tolerance)
       .rw("mu_step", &O::mu_step)
       .rw("max_iterations", &O::max_iterations)
       .rw("max_time_s", &O::max_time_s)
