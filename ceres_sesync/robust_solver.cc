@@ -348,8 +348,9 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // weighted solves then stop their local searches at
   // gnc_relative_gradient_tolerance or gnc_relative_decrease_tolerance, prove
   // their certificates in double only (they decide saddle escapes; no bound of
-  // theirs is reported) and climb to gnc_max_rank, with no certificate test
-  // there; each final inlier problem is solved with the caller's options again.
+  // theirs is reported), climb to gnc_max_rank, with no certificate test
+  // there, and round without refinement (gnc_refine_rounded_solution); each
+  // final inlier problem is solved with the caller's options again.
   // The Staircase reads its options at every stage.
   SolverOptions solve_options = options.solver_options;
   // Gives the next solve the time left (options.max_time_s) and says whether
@@ -489,6 +490,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       solve_options.relative_decrease_tolerance =
           options.gnc_relative_decrease_tolerance;
     }
+    solve_options.refine_rounded_solution = options.gnc_refine_rounded_solution;
     solve_options.max_rank = std::min(
         options.solver_options.max_rank,
         options.gnc_max_rank > 0 ? std::max(options.gnc_max_rank, r0) : r0 + 2);

@@ -468,6 +468,38 @@ bool SmallNoisyCubeWithOutliers(uint64_t seed, PoseGraph* corrupted,
   return AddOutliers(clean, o, corrupted, added, nullptr);
 }
 
+// The GNC steps round without the local refinement unless
+// gnc_refine_rounded_solution: one step from the same start, the same
+// staircase run, and the refinement's iterations on top when asked for,
+// wherever the step's relaxation is not exact (its wrong closures still
+// weighted, it ends at the GNC steps' top rank untested).
+TEST(RobustSolver, GncStepsRefineTheirRoundingOnlyWhenAsked) {
+  int inexact_steps = 0;
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
+    PoseGraph corrupted;
+    // (Refused where the cube has no loop closure to replace.)
+    if (!SmallNoisyCubeWithOutliers(seed, &corrupted, nullptr)) continue;
+    RobustSolverOptions options = Options();
+    options.max_iterations = 1;
+    options.gnc_threshold_fractions = {1.0};
+    RobustSolverSummary plain, refined;
+    SolveRobust(corrupted, options, &plain);
+    if (plain.history.empty() ||
+        plain.history[0].status != SolverSummary::Status::kMaxRankReached) {
+      continue;
+    }
+    ++inexact_steps;
+    options.gnc_refine_rounded_solution = true;
+    SolveRobust(corrupted, options, &refined);
+    ASSERT_EQ(refined.history.size(), 1u) << refined.FullReport();
+    EXPECT_EQ(plain.history[0].rank, refined.history[0].rank);
+    EXPECT_GT(refined.history[0].solver_iterations,
+              plain.history[0].solver_iterations)
+        << "seed " << seed;
+  }
+  EXPECT_GE(inexact_steps, 3) << inexact_steps;
+}
+
 // A wrong closure the map bends to fit within c^2: the first solve
 // accepts every measurement but its relaxation is not exact (not
 // certified). GNC must still run (at the fractions of c^2 below the largest

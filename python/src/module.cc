@@ -990,6 +990,7 @@ void BindRobust(py::module_& m) {
           &O::gnc_relative_gradient_tolerance)
       .rw("gnc_relative_decrease_tolerance",
           &O::gnc_relative_decrease_tolerance)
+      .rw("gnc_refine_rounded_solution", &O::gnc_refine_rounded_solution)
       .rw("mu_step", &O::mu_step)
       .rw("max_iterations", &O::max_iterations)
       .rw("max_time_s", &O::max_time_s)
