@@ -173,17 +173,19 @@ struct RobustSolverOptions {
   // SO(d)^n (SolverOptions::refine_rounded_solution) before the next
   // weights are computed from them. The first solve, the inlier problem,
   // the consistency rounds and the re-admission trials keep solver_options'.
-  // The refinement matters where a step's relaxation is not exact (every
-  // early step with outliers): it descends from the rounding to a local
-  // minimum of that weighted problem, whose weights still include wrong
-  // closures. Off, GNC's weights come from the relaxation's rounded
-  // solution. Measured (bench/results/gnc_refinement/, both with the
-  // decrease tolerance above): intel, kitti_00, smallGrid3D at 30/50%
-  // random outliers, seeds 1-9: 45 -> 49 of 54 runs exact (intel 11 ->
+  // The refinement matters where a step's relaxation is not exact (often
+  // so in the early steps, wrong closures still weighted): it descends from
+  // the rounding to a local minimum of that weighted problem, whose weights
+  // still include wrong closures. Off, GNC's weights come from the
+  // relaxation's rounded solution. Measured (bench/results/gnc_refinement/,
+  // both with the decrease tolerance above): intel, kitti_00, smallGrid3D at
+  // 30/50% random outliers, seeds 1-9: 45 -> 49 of 54 runs exact (intel 11 ->
   // 15 of 18); five datasets at 10/30/50%, seeds 1-3: 43 -> 44 of 45;
   // clustered outliers on four datasets: 20 -> 25 of 36; 154 noisy cubes:
-  // 90 -> 88; every verdict the same on the eight larger runs (city10000,
-  // cubicle, sphere2500, torus3D, parking-garage, manhattan).
+  // 90 -> 88; every verdict the same on ten larger runs (city10000 at two
+  // thresholds, cubicle, sphere2500 at 10 and 30%, torus3D,
+  // parking-garage, manhattan at 10/30/50%); ais2klinik + 10%, a failure
+  // either way, rejects 6 true closures instead of 3.
   bool gnc_refine_rounded_solution = false;
 
   // Largest staircase rank of the GNC steps' weighted solves, at least r0
