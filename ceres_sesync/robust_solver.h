@@ -293,7 +293,9 @@ struct RobustSolverSummary {
     // returned poses are the last connected step's; see message.
     kInlierGraphDisconnected,
     // max_time_s ran out before GNC ended (see max_time_s): the poses of
-    // the last step, verdicts from its weights; not certified.
+    // the last step (its rounding, refined only with
+    // gnc_refine_rounded_solution), verdicts from its weights; not
+    // certified.
     kTimeLimit,
     // The graph or the options failed validation; see message.
     kInvalidInput,
