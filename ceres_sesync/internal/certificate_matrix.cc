@@ -96,6 +96,10 @@ double CertificateMatrix::factorization_flops() const {
   return double_->flops();
 }
 
+double CertificateMatrix::factor_nonzeros() const {
+  return static_cast<double>(double_->factor_nonzeros());
+}
+
 bool CertificateMatrix::supernodal() const {
   return 2 * double_->flops() >=
          kSupernodalSwitch * std::max<double>(1, double_->factor_nonzeros());
@@ -252,7 +256,7 @@ bool CertificateMatrix::FactorizeDouble() {
   last_double_seconds_ =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  if (double_factorized_) complete_double_seconds_ = last_double_seconds_;
+  double_completed_ = double_completed_ || double_factorized_;
   return double_factorized_;
 }
 

@@ -120,10 +120,8 @@ class CertificateMatrix {
   // 4.6x the double time, the measured upper end: 1.8x on ais2klinik, 2.7-4.0x
   // on the 3D datasets and city10000, 4.6x on a 10^5-pose city); 0 if unknown.
   double PredictedSeconds(ProofPrecision precision) const;
-  // Seconds of the last double factorization that completed (a failed one
-  // stops early, so its time can be far below a full factorization's); 0
-  // if none has.
-  double complete_double_seconds() const { return complete_double_seconds_; }
+  // Whether a double factorization has completed (succeeded) on this matrix.
+  bool double_completed() const { return double_completed_; }
 
   // Factorizations so far, by arithmetic, and the seconds spent in the
   // double-double ones (including their assembly).
@@ -139,6 +137,8 @@ class CertificateMatrix {
   double FactorizationCostInSolves(int r) const;
   // Multiply-adds of one factorization (sum over columns of count^2 / 2).
   double factorization_flops() const;
+  // Nonzeros of the factor L (diagonal included).
+  double factor_nonzeros() const;
 
   // Dimension dn of S.
   int dimension() const { return rotation_size_; }
@@ -197,7 +197,7 @@ class CertificateMatrix {
   int double_factorizations_ = 0, extended_factorizations_ = 0;
   double extended_time_s_ = 0;
   double last_double_seconds_ = 0, last_extended_seconds_ = 0;
-  double complete_double_seconds_ = 0;
+  bool double_completed_ = false;
   std::chrono::steady_clock::time_point deadline_ =
       std::chrono::steady_clock::time_point::max();
   bool timed_out_ = false;

@@ -457,6 +457,12 @@ void SESyncProblem::MultiplyQ(const Eigen::MatrixXd& Y,
   MultiplyBySparse(Z, minus_Vbar_, /*accumulate=*/true, num_threads_, YQ);
 }
 
+double SESyncProblem::MultiplyQCost() const {
+  AwaitLbar();
+  return static_cast<double>(D_.nonZeros()) + 2.0 * Vbar_.nonZeros() +
+         2.0 * (Lbar_.rows() == 0 ? 0 : lbar_solver_.stored_entries());
+}
+
 double SESyncProblem::LbarBackwardError() const {
   AwaitLbar();
   if (Lbar_.rows() == 0) return 0;

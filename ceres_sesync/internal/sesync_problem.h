@@ -393,6 +393,10 @@ class SESyncProblem {
 
   // YQ = Y * Q for Y of size r x dn. O(m r) plus one Cholesky solve.
   void MultiplyQ(const Eigen::MatrixXd& Y, Eigen::MatrixXd* YQ) const;
+  // Multiply-adds of MultiplyQ() per row of Y: the entries of D, of Vbar
+  // (twice) and of Lbar's factor (two triangular solves). From the patterns,
+  // so the same on every run and machine, unlike a measured time.
+  double MultiplyQCost() const;
 
   // Optimal translations (d x N, eq. 21: every translation node, landmarks
   // included) for the rotations R (d x dn), with the gauge node at 0.

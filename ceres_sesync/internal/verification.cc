@@ -174,24 +174,26 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // than two double factorizations, the witness's other route (a proof
   // above lambda_min, then shift-and-invert Lanczos on its factor). Its
   // products with Q cost O(m r) but solve with Lbar, whose factor fills on
-  // 3D lattices: on a 97,336-pose cube one product took 43 ms, so the ~160
-  // of a Lanczos run that did not converge cost 6.9 s against 0.9 s per
-  // factorization. Unknown before a factorization has completed (Certify()
-  // of a poor guess: there Lanczos wins, cubicle's file guess 0.45 -> 0.19
-  // s, torus3D's 0.24 -> 0.13 s). One product is timed, once.
-  double product_seconds = -1;
+  // 3D lattices: on a 97,336-pose cube ~160 products (a Lanczos run that did
+  // not converge) cost 6.9 s against 0.9 s per factorization. Before a
+  // factorization has completed (Certify() of a poor guess) Lanczos goes
+  // first: it wins there (cubicle's file guess 0.45 -> 0.19 s, torus3D's
+  // 0.24 -> 0.13 s). Predicted from the patterns, not timed, so that the
+  // route, and with it the result, is the same on every run however loaded
+  // the machine (a timed gate made an 8-pose graph's result differ between
+  // two runs under ctest -j2). The unit: one multiply-add of a product
+  // (2.6-4.9 ns measured, one thread, over the 12 datasets, cubes of 10^3 to
+  // 46^3 poses and a 10^5-pose city). A factorization costs ~2.5 of them per
+  // entry of L (11-22 ns measured: the simplicial work per entry) plus 1/64
+  // per multiply-add of its own (supernodal dense kernels). On those graphs
+  // the model's ratio of the two routes was 0.96-1.57x the timed one (timed
+  // 3.1-36: Lanczos the dearer route on all of them once a factorization
+  // had completed).
   auto lanczos_is_cheap = [&]() {
-    const double factorization = matrix->complete_double_seconds();
-    if (factorization <= 0) return true;
-    if (product_seconds < 0) {
-      const auto start = std::chrono::steady_clock::now();
-      MultiplyCertificate(problem, Lambda,
-                          Eigen::VectorXd::Ones(matrix->dimension()));
-      product_seconds = std::chrono::duration<double>(
-                            std::chrono::steady_clock::now() - start)
-                            .count();
-    }
-    return kLanczosMaxProducts * product_seconds < 2 * factorization;
+    if (!matrix->double_completed()) return true;
+    const double factorization =
+        2.5 * matrix->factor_nonzeros() + matrix->factorization_flops() / 64;
+    return kLanczosMaxProducts * problem.MultiplyQCost() < 2 * factorization;
   };
   double failed_double = 0;  // The largest shift a double proof failed at.
   auto prove = [&](double c, ProofPrecision precision) {
