@@ -1,18 +1,22 @@
 #include "ceres_sesync/robust_solver.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "Eigen/Eigenvalues"
 #include "Eigen/Geometry"
 #include "ceres_sesync/internal/chi_square.h"
 #include "ceres_sesync/internal/measurement_weights.h"
+#include "ceres_sesync/internal/parallel.h"
 #include "ceres_sesync/internal/staircase.h"
 #include "ceres_sesync/stiefel_manifold.h"
 
@@ -152,12 +156,14 @@ class WeightedProblem {
   }
 
   // The problem with `weights` (one per graph measurement) for the next
-  // solve; false with a message if they leave the graph disconnected.
+  // solve; false with a message if they leave the graph disconnected. The
+  // first call builds the problem unless Start() did.
   bool SetWeights(const MeasurementWeights& weights, std::string* message) {
     if (!internal::CheckMeasurementWeights(graph_, weights, message)) {
       return false;
     }
     const size_t m = graph_.measurements.size();
+    if (staircase_ == nullptr) return Rebuild(weights, message);
     const size_t pattern = index_.empty() ? m : index_.size();
     size_t positive = 0, zero_in_pattern = 0;
     for (double w : weights) positive += w > 0;
@@ -172,9 +178,19 @@ class WeightedProblem {
       *message = summary_.message;
       return false;
     }
-    // Rebuild on the positive subgraph (the Staircase first: it refers to
-    // the subgraph).
-    staircase_.reset();
+    ++rebuilds_;
+    return Rebuild(weights, message);
+  }
+
+  internal::Staircase& staircase() { return *staircase_; }
+  const SolverSummary& summary() const { return summary_; }
+  int rebuilds() const { return rebuilds_; }
+
+ private:
+  // Builds the problem on the subgraph of positive weights.
+  bool Rebuild(const MeasurementWeights& weights, std::string* message) {
+    const size_t m = graph_.measurements.size();
+    staircase_.reset();  // First: it refers to the subgraph.
     if (sub_.measurements.empty() && sub_.num_poses == 0) {
       sub_ = graph_;  // Poses, ids, initial poses and FIX: Round()'s gauge.
     }
@@ -192,17 +208,11 @@ class WeightedProblem {
     if (all_one) sub_weights.clear();
     staircase_ = std::make_unique<internal::Staircase>(
         sub_, options_, &summary_, Clock::now(), std::move(sub_weights));
-    ++rebuilds_;
     if (staircase_->ok()) return true;
     *message = summary_.message;
     return false;
   }
 
-  internal::Staircase& staircase() { return *staircase_; }
-  const SolverSummary& summary() const { return summary_; }
-  int rebuilds() const { return rebuilds_; }
-
- private:
   const PoseGraph& graph_;
   const SolverOptions& options_;
   PoseGraph sub_;           // The pattern's measurements, once rebuilt.
@@ -352,12 +362,12 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // there, and round without refinement (gnc_refine_rounded_solution); each
   // final inlier problem is solved with the caller's options again.
   // The Staircase reads its options at every stage.
-  SolverOptions solve_options = options.solver_options;
+  SolverOptions first_options = options.solver_options;
   // Gives the next solve the time left (options.max_time_s) and says whether
   // any is left. solve_options.max_time_s is the caller's per-solve limit
   // or what remains of the whole, the smaller (the Staircase counts from the
   // re-weighting or rebuild that precedes each solve).
-  auto budget = [&]() {
+  auto budget = [&](SolverOptions& solve_options) {
     solve_options.max_time_s = options.solver_options.max_time_s;
     if (options.max_time_s <= 0) return true;
     const double left = options.max_time_s - Seconds(start);
@@ -367,36 +377,36 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     }
     return true;
   };
-  budget();
+  budget(first_options);
   const int r0 = options.solver_options.initial_rank > 0
                      ? options.solver_options.initial_rank
                      : d + 2;
-  solve_options.max_rank = std::min(options.solver_options.max_rank,
+  first_options.max_rank = std::min(options.solver_options.max_rank,
                                     std::max(options.initial_max_rank, r0));
-  WeightedProblem problem(graph, solve_options);
-  problem.Start(start);
+  WeightedProblem first_problem(graph, first_options);
+  first_problem.Start(start);
   auto invalid = [&]() {
-    s.message = problem.summary().message;
-    s.initial_summary = problem.summary();
+    s.message = first_problem.summary().message;
+    s.initial_summary = first_problem.summary();
     return finish(RobustSolverSummary::Status::kInvalidInput, {});
   };
-  if (!problem.staircase().ok()) return invalid();
+  if (!first_problem.staircase().ok()) return invalid();
   std::vector<char> known(m, 0);
   for (size_t k = 0; k < m; ++k) {
     known[k] =
         options.known_inliers == RobustSolverOptions::KnownInliers::kOdometry &&
         IsOdometry(graph.measurements[k]);
   }
-  if (problem.staircase().trivial()) {  // One pose, no measurements.
-    s.initial_summary = s.inlier_summary = problem.summary();
+  if (first_problem.staircase().trivial()) {  // One pose, no measurements.
+    s.initial_summary = s.inlier_summary = first_problem.summary();
     s.weights_binary = true;
     return finish(RobustSolverSummary::Status::kConverged,
-                  problem.staircase().Trivial().poses);
+                  first_problem.staircase().Trivial().poses);
   }
   Eigen::MatrixXd Y0;
-  if (!problem.staircase().Initialize(nullptr, &Y0)) return invalid();
-  problem.staircase().Run(&Y0);
-  Poses poses0 = problem.staircase().Round(Y0).poses;
+  if (!first_problem.staircase().Initialize(nullptr, &Y0)) return invalid();
+  first_problem.staircase().Run(&Y0);
+  Poses poses0 = first_problem.staircase().Round(Y0).poses;
   auto max_estimated_cost = [&](const std::vector<double>& f) {
     double max_f = 0;
     for (size_t k = 0; k < m; ++k) {
@@ -406,27 +416,29 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   };
   std::vector<double> f0 = Costs(graph, poses0);
   double max_cost = max_estimated_cost(f0);
-  solve_options.max_rank = options.solver_options.max_rank;
+  first_options.max_rank = options.solver_options.max_rank;
   if (max_cost <= c2 &&
-      problem.summary().status == SolverSummary::Status::kMaxRankReached &&
-      problem.summary().final_rank < solve_options.max_rank && budget()) {
+      first_problem.summary().status ==
+          SolverSummary::Status::kMaxRankReached &&
+      first_problem.summary().final_rank < first_options.max_rank &&
+      budget(first_options)) {
     // Every measurement fits: perhaps this is the inlier problem. The
     // staircase continues where a rank cap stopped it (as Solve() would).
-    problem.staircase().Run(&Y0);
-    poses0 = problem.staircase().Round(Y0).poses;
+    first_problem.staircase().Run(&Y0);
+    poses0 = first_problem.staircase().Round(Y0).poses;
     f0 = Costs(graph, poses0);
     max_cost = max_estimated_cost(f0);
   }
-  problem.staircase().Report(Y0, Solution{poses0, {}});
-  s.initial_summary = problem.summary();
+  first_problem.staircase().Report(Y0, Solution{poses0, {}});
+  s.initial_summary = first_problem.summary();
   s.initial_time_s = Seconds(start);
-  if (max_cost <= c2 && problem.summary().certified()) {
+  if (max_cost <= c2 && first_problem.summary().certified()) {
     // Every measurement fits the certified optimum of the whole problem:
     // accepting all of them is TLS-consistent, and this is the inlier
     // problem. (Uncertified, e.g. an inexact relaxation because a wrong
     // closure bends the map until it fits, GNC runs at the thresholds
     // below the largest f_k.)
-    s.inlier_summary = problem.summary();
+    s.inlier_summary = first_problem.summary();
     s.total_time_s = Seconds(start);
     s.weights_binary = true;
     FillEdges(graph, poses0, MeasurementWeights(m, 1.0), known,
@@ -441,7 +453,11 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // the last estimate, weighted solve warm-started from the last factor
   // (its negligible directions dropped), mu update, convergence test; then
   // the accepted set's problem, certified, and the consistency rounds at c^2.
-  auto run_gnc = [&](double fraction) {
+  // On `problem` (the first solve's or a problem of the run's own, built at
+  // its first step) with `solve_options`, the options `problem` refers to,
+  // and `base`, the caller's options as this run uses them.
+  auto run_gnc = [&](double fraction, const SolverOptions& base,
+                     SolverOptions& solve_options, WeightedProblem& problem) {
     const auto run_start = Clock::now();
     GncRun run;
     run.record.gnc_threshold = fraction * c2;
@@ -495,7 +511,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         options.solver_options.max_rank,
         options.gnc_max_rank > 0 ? std::max(options.gnc_max_rank, r0) : r0 + 2);
     for (int it = 0; it < options.max_iterations; ++it) {
-      if (!budget()) {
+      if (!budget(solve_options)) {
         run.status = RobustSolverSummary::Status::kTimeLimit;
         break;
       }
@@ -548,7 +564,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // The problem restricted to the accepted measurements (weights rounded
     // at 1/2), solved from the last factor with the caller's options (the
     // Staircase refers to solve_options, so it is restored in place).
-    solve_options = options.solver_options;
+    solve_options = base;
     run.accepted.assign(m, 0);
     for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
     auto record = [&]() {
@@ -560,7 +576,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       run.inlier_time_s = Seconds(inlier_start);
       return run;
     };
-    if (run.status == RobustSolverSummary::Status::kTimeLimit || !budget()) {
+    if (run.status == RobustSolverSummary::Status::kTimeLimit ||
+        !budget(solve_options)) {
       // Out of time: the last step's poses (the first solve's if none ran)
       // and its rounded weights; no inlier problem was solved, so its
       // summary proves nothing (the last step's is of a weighted problem).
@@ -623,7 +640,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
           changed = true;
         }
         if (!changed) return true;
-        if (!budget()) {
+        if (!budget(solve_options)) {
           out_of_time = true;
           return true;
         }
@@ -691,7 +708,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         }
       }
       if (candidate < 0) break;
-      if (!budget()) {
+      if (!budget(solve_options)) {
         out_of_time = true;
         break;
       }
@@ -722,7 +739,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         restore = true;
       }
     }
-    if (restore && !budget()) {
+    if (restore && !budget(solve_options)) {
       // No time to solve the accepted set again: its last report stands
       // (run.poses and Y are still its optimum).
       out_of_time = true;
@@ -742,15 +759,74 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     return record();
   };
 
-  // Every schedule; the lowest TLS cost at c^2 wins (the first on ties).
+  // Every schedule. The first run continues the first solve's problem; each
+  // other run builds a problem of its own, so that no run depends on another
+  // and they can go at once: with T >= 2 threads (solver_options.num_threads),
+  // W = min(T, runs) runs at a time, ~T / W threads each. The kernels' results
+  // do not depend on the thread count, so the runs' results are the same as
+  // one after another; a run's problem (data matrices, factors) lives while
+  // it runs. The calling thread runs the first run (SolverOptions::progress
+  // is called from it alone); callbacks are serialized.
   const auto gnc_start = Clock::now();
+  const size_t num_runs = options.gnc_threshold_fractions.size();
+  const int threads =
+      internal::ResolveNumThreads(options.solver_options.num_threads);
+  const int workers = static_cast<int>(
+      std::min<size_t>(num_runs, static_cast<size_t>(threads)));
+  std::vector<GncRun> runs(num_runs);
+  std::vector<char> ran(num_runs, 0);
+  std::vector<int> rebuilds(num_runs, 0);
+  std::mutex callback_mutex;
+  auto execute = [&](size_t q, bool on_caller) {
+    SolverOptions base = options.solver_options;
+    if (workers > 1) {
+      // (The calling thread takes what does not divide evenly.)
+      base.num_threads =
+          threads / workers + (on_caller ? threads % workers : 0);
+      if (!on_caller) base.progress = nullptr;
+      if (base.callback) {
+        base.callback = [inner = options.solver_options.callback,
+                         &callback_mutex](int rank, int iteration, double f,
+                                          double gradient_norm,
+                                          double trust_radius) {
+          std::lock_guard<std::mutex> lock(callback_mutex);
+          return inner(rank, iteration, f, gradient_norm, trust_radius);
+        };
+      }
+    }
+    // Out of time: the runs so far (at least one) compete.
+    SolverOptions probe = base;
+    if (q > 0 && !budget(probe)) return;
+    const double fraction = options.gnc_threshold_fractions[q];
+    if (q == 0) {
+      first_options = base;
+      runs[q] = run_gnc(fraction, base, first_options, first_problem);
+    } else {
+      SolverOptions solve_options = base;
+      WeightedProblem problem(graph, solve_options);
+      runs[q] = run_gnc(fraction, base, solve_options, problem);
+      rebuilds[q] = problem.rebuilds();
+    }
+    runs[q].record.status = runs[q].status;
+    ran[q] = 1;
+  };
+  {
+    std::atomic<size_t> next(1);
+    auto rest = [&](bool on_caller) {
+      for (size_t q; (q = next++) < num_runs;) execute(q, on_caller);
+    };
+    std::vector<std::thread> helpers;
+    for (int w = 1; w < workers; ++w) helpers.emplace_back(rest, false);
+    execute(0, true);
+    rest(true);
+    for (std::thread& helper : helpers) helper.join();
+  }
+  // The lowest TLS cost at c^2 wins (the first on ties).
   GncRun best;
   int best_index = -1;
-  for (size_t q = 0; q < options.gnc_threshold_fractions.size(); ++q) {
-    // Out of time: the runs so far (at least one) compete.
-    if (q > 0 && !budget()) break;
-    GncRun run = run_gnc(options.gnc_threshold_fractions[q]);
-    run.record.status = run.status;
+  for (size_t q = 0; q < num_runs; ++q) {
+    if (!ran[q]) continue;
+    GncRun& run = runs[q];
     s.runs.push_back(run.record);
     // A finished run beats one the time limit cut short (its verdicts are
     // rounded weights, its inlier problem unsolved), which beats a
@@ -774,6 +850,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     }
   }
   s.gnc_time_s = Seconds(gnc_start);
+  s.concurrent_runs = workers;
   s.inlier_time_s = best.inlier_time_s;
   s.selected_run = best_index;
   s.gnc_threshold = best.record.gnc_threshold;
@@ -785,7 +862,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.weights_binary = best.weights_binary;
   s.message = best.message;
   s.inlier_summary = best.inlier_summary;
-  s.pattern_rebuilds = problem.rebuilds();
+  s.pattern_rebuilds = first_problem.rebuilds();
+  for (int r : rebuilds) s.pattern_rebuilds += r;
   FillEdges(graph, best.poses, best.weights, known, best.accepted, c2, &s);
   return finish(best.status, std::move(best.poses));
 }
@@ -923,7 +1001,12 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   }
   out += "\nTime (seconds)\n";
   line("%-34s %.4f\n", "  First solve", initial_time_s);
-  line("%-34s %.4f\n", "  GNC runs", gnc_time_s);
+  line("%-34s %.4f\n",
+       concurrent_runs > 1
+           ? ("  GNC runs (" + std::to_string(concurrent_runs) + " at once)")
+                 .c_str()
+           : "  GNC runs",
+       gnc_time_s);
   line("%-34s %.4f\n", "    selected run after GNC", inlier_time_s);
   line("%-34s %.4f\n", "Total", total_time_s);
   line("\n%-34s %s\n", "Status", StatusString().c_str());

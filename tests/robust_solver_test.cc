@@ -5,10 +5,14 @@
 
 #include "ceres_sesync/robust_solver.h"
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <random>
+#include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "ceres_sesync/ceres_baseline.h"
@@ -637,6 +641,66 @@ TEST(RobustSolver, DeterministicForSeedAndThreads) {
       EXPECT_EQ(pa[i].R, (*other)[i].R);
       EXPECT_EQ(pa[i].t, (*other)[i].t);
     }
+  }
+}
+
+// With two threads the two GNC runs go at once, one thread each: the
+// result is still the one-thread result, progress reports come from the
+// calling thread alone, and the per-iteration callbacks (from both runs'
+// threads) come one at a time.
+TEST(RobustSolver, ConcurrentRunsKeepTheResultAndReportFromOneThreadAtATime) {
+  const PoseGraph clean = ChainGraph(3, 40, 30, false, 4, nullptr);
+  OutlierOptions o;
+  o.fraction = 0.3;
+  o.seed = 9;
+  PoseGraph corrupted;
+  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, nullptr, nullptr));
+  RobustSolverSummary serial;
+  const Poses expected = SolveRobust(corrupted, Options(), &serial);
+  ASSERT_EQ(serial.runs.size(), 2u);
+
+  RobustSolverOptions options = Options();
+  options.solver_options.num_threads = 2;
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<int> inside(0), overlaps(0), calls(0);
+  std::mutex mutex;
+  std::set<std::thread::id> callback_threads;
+  options.solver_options.callback = [&](int, int, double, double, double) {
+    if (inside.fetch_add(1) != 0) ++overlaps;
+    ++calls;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      callback_threads.insert(std::this_thread::get_id());
+    }
+    // Long enough for two unserialized runs to meet here.
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+    inside.fetch_sub(1);
+    return true;
+  };
+  std::atomic<int> progress_calls(0), progress_elsewhere(0);
+  options.solver_options.progress = [&](const SolverProgress&) {
+    ++progress_calls;
+    if (std::this_thread::get_id() != caller) ++progress_elsewhere;
+  };
+  RobustSolverSummary s;
+  const Poses poses = SolveRobust(corrupted, options, &s);
+  EXPECT_EQ(serial.concurrent_runs, 1);
+  EXPECT_EQ(s.concurrent_runs, 2);
+  EXPECT_EQ(callback_threads.size(), 2u);  // Both runs' threads called.
+  EXPECT_GT(calls.load(), 0);
+  EXPECT_EQ(overlaps.load(), 0);
+  EXPECT_GT(progress_calls.load(), 0);
+  EXPECT_EQ(progress_elsewhere.load(), 0);
+  EXPECT_EQ(s.outlier_edges, serial.outlier_edges);
+  ASSERT_EQ(s.runs.size(), serial.runs.size());
+  for (size_t q = 0; q < s.runs.size(); ++q) {
+    EXPECT_EQ(s.runs[q].tls_cost, serial.runs[q].tls_cost);
+    EXPECT_EQ(s.runs[q].iterations, serial.runs[q].iterations);
+  }
+  ASSERT_EQ(poses.size(), expected.size());
+  for (size_t i = 0; i < poses.size(); ++i) {
+    EXPECT_EQ(poses[i].R, expected[i].R);
+    EXPECT_EQ(poses[i].t, expected[i].t);
   }
 }
 

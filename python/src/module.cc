@@ -1082,6 +1082,7 @@ void BindRobust(py::module_& m) {
       .ro("consistency_rounds", &S::consistency_rounds)
       .ro("readmissions", &S::readmissions)
       .ro("pattern_rebuilds", &S::pattern_rebuilds)
+      .ro("concurrent_runs", &S::concurrent_runs)
       .ro("initial_time_s", &S::initial_time_s)
       .ro("gnc_time_s", &S::gnc_time_s)
       .ro("inlier_time_s", &S::inlier_time_s)
