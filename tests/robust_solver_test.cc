@@ -13,6 +13,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "ceres_sesync/ceres_baseline.h"
@@ -311,9 +312,13 @@ TEST(RobustSolver, GncStepsStopAtTheirRelativeDecreaseTolerance) {
 
 // max_time_s limits the whole robust solve. Out of time during GNC: status
 // kTimeLimit, not certified, the poses and verdicts of where it stopped;
-// with time to spare: the result of the unlimited solve.
+// with time to spare: the result of the unlimited solve. Also with two
+// threads (the GNC runs at once).
 TEST(RobustSolver, TimeLimitHoldsForTheWholeSolve) {
-  for (int d : {2, 3}) {
+  for (const auto& [d, threads] :
+       {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 2}, std::pair{3, 2}}) {
+    SCOPED_TRACE("d = " + std::to_string(d) +
+                 ", threads = " + std::to_string(threads));
     PoseGraph corrupted;
     std::vector<int> added;
     ASSERT_TRUE(NoisyChainWithOutliers(d, &corrupted, &added));
@@ -322,6 +327,7 @@ TEST(RobustSolver, TimeLimitHoldsForTheWholeSolve) {
     ASSERT_TRUE(unlimited.certified()) << unlimited.FullReport();
 
     RobustSolverOptions options = Options();
+    options.solver_options.num_threads = threads;
     options.max_time_s = 1e-4;
     RobustSolverSummary s;
     const auto start = std::chrono::steady_clock::now();
