@@ -616,16 +616,23 @@ TEST(RobustSolver, ScaledReadmissionKeepsOutAWrongClosureTheMapBendsToFit) {
             scaled.runs[scaled.selected_run].tls_cost);
 }
 
-// The same input and options (thread count included) give the same result,
-// bitwise; so do 1 and 2 threads (the kernels' results do not depend on
-// the thread count).
-TEST(RobustSolver, DeterministicForSeedAndThreads) {
+// A 3D chain of 40 poses with 30% of its loop closures replaced by wrong
+// ones (both GNC runs work on it).
+PoseGraph ChainWithOutliers() {
   const PoseGraph clean = ChainGraph(3, 40, 30, false, 4, nullptr);
   OutlierOptions o;
   o.fraction = 0.3;
   o.seed = 9;
   PoseGraph corrupted;
-  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, nullptr, nullptr));
+  EXPECT_TRUE(AddOutliers(clean, o, &corrupted, nullptr, nullptr));
+  return corrupted;
+}
+
+// The same input and options (thread count included) give the same result,
+// bitwise; so do 1 and 2 threads (the kernels' results do not depend on
+// the thread count; with 2 the GNC runs go at once).
+TEST(RobustSolver, DeterministicForSeedAndThreads) {
+  const PoseGraph corrupted = ChainWithOutliers();
   RobustSolverOptions options = Options();
   RobustSolverSummary a, b, c;
   const Poses pa = SolveRobust(corrupted, options, &a);
@@ -650,19 +657,13 @@ TEST(RobustSolver, DeterministicForSeedAndThreads) {
   }
 }
 
-// With two threads the two GNC runs go at once, one thread each: the
-// result is still the one-thread result, progress reports come from the
-// calling thread alone, and the per-iteration callbacks (from both runs'
-// threads) come one at a time.
-TEST(RobustSolver, ConcurrentRunsKeepTheResultAndReportFromOneThreadAtATime) {
-  const PoseGraph clean = ChainGraph(3, 40, 30, false, 4, nullptr);
-  OutlierOptions o;
-  o.fraction = 0.3;
-  o.seed = 9;
-  PoseGraph corrupted;
-  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, nullptr, nullptr));
+// With two threads the two GNC runs go at once, one thread each: progress
+// reports still come from the calling thread alone, and the per-iteration
+// callbacks (from both runs' threads) one at a time.
+TEST(RobustSolver, ConcurrentRunsReportFromOneThreadAtATime) {
+  const PoseGraph corrupted = ChainWithOutliers();
   RobustSolverSummary serial;
-  const Poses expected = SolveRobust(corrupted, Options(), &serial);
+  SolveRobust(corrupted, Options(), &serial);
   ASSERT_EQ(serial.runs.size(), 2u);
 
   RobustSolverOptions options = Options();
@@ -689,7 +690,7 @@ TEST(RobustSolver, ConcurrentRunsKeepTheResultAndReportFromOneThreadAtATime) {
     if (std::this_thread::get_id() != caller) ++progress_elsewhere;
   };
   RobustSolverSummary s;
-  const Poses poses = SolveRobust(corrupted, options, &s);
+  SolveRobust(corrupted, options, &s);
   EXPECT_EQ(serial.concurrent_runs, 1);
   EXPECT_EQ(s.concurrent_runs, 2);
   EXPECT_EQ(callback_threads.size(), 2u);  // Both runs' threads called.
@@ -698,16 +699,6 @@ TEST(RobustSolver, ConcurrentRunsKeepTheResultAndReportFromOneThreadAtATime) {
   EXPECT_GT(progress_calls.load(), 0);
   EXPECT_EQ(progress_elsewhere.load(), 0);
   EXPECT_EQ(s.outlier_edges, serial.outlier_edges);
-  ASSERT_EQ(s.runs.size(), serial.runs.size());
-  for (size_t q = 0; q < s.runs.size(); ++q) {
-    EXPECT_EQ(s.runs[q].tls_cost, serial.runs[q].tls_cost);
-    EXPECT_EQ(s.runs[q].iterations, serial.runs[q].iterations);
-  }
-  ASSERT_EQ(poses.size(), expected.size());
-  for (size_t i = 0; i < poses.size(); ++i) {
-    EXPECT_EQ(poses[i].R, expected[i].R);
-    EXPECT_EQ(poses[i].t, expected[i].t);
-  }
 }
 
 // Two clusters joined only by two contradicting measurements, neither of
