@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -811,15 +812,32 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     ran[q] = 1;
   };
   {
+    // An exception (std::bad_alloc, a throwing callback) in any run reaches
+    // the caller once every thread has stopped: the first one thrown; runs
+    // not yet started are skipped, running ones finish.
     std::atomic<size_t> next(1);
+    std::mutex error_mutex;
+    std::exception_ptr error;
+    auto guarded = [&](auto&& work) {
+      try {
+        work();
+      } catch (...) {
+        next = num_runs;  // No run starts after it.
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    };
     auto rest = [&](bool on_caller) {
-      for (size_t q; (q = next++) < num_runs;) execute(q, on_caller);
+      guarded([&] {
+        for (size_t q; (q = next++) < num_runs;) execute(q, on_caller);
+      });
     };
     std::vector<std::thread> helpers;
     for (int w = 1; w < workers; ++w) helpers.emplace_back(rest, false);
-    execute(0, true);
+    guarded([&] { execute(0, true); });
     rest(true);
     for (std::thread& helper : helpers) helper.join();
+    if (error) std::rethrow_exception(error);
   }
   // The lowest TLS cost at c^2 wins (the first on ties).
   GncRun best;

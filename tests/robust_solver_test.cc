@@ -11,6 +11,7 @@
 #include <mutex>
 #include <random>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
@@ -699,6 +700,23 @@ TEST(RobustSolver, ConcurrentRunsReportFromOneThreadAtATime) {
   EXPECT_GT(progress_calls.load(), 0);
   EXPECT_EQ(progress_elsewhere.load(), 0);
   EXPECT_EQ(s.outlier_edges, serial.outlier_edges);
+}
+
+// An exception thrown in a run on another thread (here by the callback,
+// only there) reaches the caller, as it would with one thread.
+TEST(RobustSolver, ExceptionsOfConcurrentRunsReachTheCaller) {
+  const PoseGraph corrupted = ChainWithOutliers();
+  RobustSolverOptions options = Options();
+  options.solver_options.num_threads = 2;
+  const std::thread::id caller = std::this_thread::get_id();
+  options.solver_options.callback = [&](int, int, double, double, double) {
+    if (std::this_thread::get_id() != caller) {
+      throw std::runtime_error("from the second run");
+    }
+    return true;
+  };
+  RobustSolverSummary s;
+  EXPECT_THROW(SolveRobust(corrupted, options, &s), std::runtime_error);
 }
 
 // Two clusters joined only by two contradicting measurements, neither of
