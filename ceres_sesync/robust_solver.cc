@@ -778,13 +778,22 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   std::vector<char> ran(num_runs, 0);
   std::vector<int> rebuilds(num_runs, 0);
   std::mutex callback_mutex;
+  // Set when a run has thrown: the others stop at their next progress report
+  // (every trust-region iteration) by throwing RunCancelled.
+  std::atomic<bool> cancelled(false);
+  struct RunCancelled {};
   auto execute = [&](size_t q, bool on_caller) {
     SolverOptions base = options.solver_options;
     if (workers > 1) {
       // (The calling thread takes what does not divide evenly.)
       base.num_threads =
           threads / workers + (on_caller ? threads % workers : 0);
-      if (!on_caller) base.progress = nullptr;
+      base.progress = [user = on_caller ? options.solver_options.progress
+                                        : nullptr,
+                       &cancelled](const SolverProgress& progress) {
+        if (cancelled) throw RunCancelled();
+        if (user) user(progress);
+      };
       if (base.callback) {
         base.callback = [inner = options.solver_options.callback,
                          &callback_mutex](int rank, int iteration, double f,
@@ -812,19 +821,25 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     ran[q] = 1;
   };
   {
-    // An exception (std::bad_alloc, a throwing callback) in any run reaches
-    // the caller once every thread has stopped: the first one thrown; runs
-    // not yet started are skipped, running ones finish.
+    // An exception (std::bad_alloc, a throwing callback, Python's Ctrl-C
+    // through the progress hook) in any run reaches the caller once every
+    // thread has stopped: the first one thrown; runs not yet started are
+    // skipped, running ones stop at their next progress report.
     std::atomic<size_t> next(1);
     std::mutex error_mutex;
     std::exception_ptr error;
     auto guarded = [&](auto&& work) {
       try {
         work();
+      } catch (const RunCancelled&) {
+        // Another run's exception is on its way.
       } catch (...) {
         next = num_runs;  // No run starts after it.
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
+        {
+          std::lock_guard<std::mutex> lock(error_mutex);
+          if (!error) error = std::current_exception();
+        }
+        cancelled = true;
       }
     };
     auto rest = [&](bool on_caller) {

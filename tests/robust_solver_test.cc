@@ -703,20 +703,37 @@ TEST(RobustSolver, ConcurrentRunsReportFromOneThreadAtATime) {
 }
 
 // An exception thrown in a run on another thread (here by the callback,
-// only there) reaches the caller, as it would with one thread.
+// only there) reaches the caller, as it would with one thread, and the
+// calling thread's run stops at its next iteration instead of finishing.
 TEST(RobustSolver, ExceptionsOfConcurrentRunsReachTheCaller) {
   const PoseGraph corrupted = ChainWithOutliers();
+  RobustSolverSummary serial;
+  SolveRobust(corrupted, Options(), &serial);
+  int first_run_iterations = 0;  // Its GNC steps' trust-region iterations.
+  for (const auto& step : serial.history) {
+    first_run_iterations += step.solver_iterations;
+  }
+  ASSERT_EQ(serial.selected_run, 0);
+  ASSERT_GT(first_run_iterations, 10);
+
   RobustSolverOptions options = Options();
   options.solver_options.num_threads = 2;
   const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<bool> thrown(false);
+  std::atomic<int> caller_calls_after(0);
   options.solver_options.callback = [&](int, int, double, double, double) {
     if (std::this_thread::get_id() != caller) {
+      thrown = true;
       throw std::runtime_error("from the second run");
     }
+    if (thrown) ++caller_calls_after;
     return true;
   };
   RobustSolverSummary s;
   EXPECT_THROW(SolveRobust(corrupted, options, &s), std::runtime_error);
+  // (Its iteration in progress when the other threw, and the next one's
+  // callback before its progress report.)
+  EXPECT_LE(caller_calls_after.load(), 2);
 }
 
 // Two clusters joined only by two contradicting measurements, neither of
