@@ -2,6 +2,8 @@
 truth, plain solve() and the command line."""
 
 import json
+import signal
+import threading
 
 import numpy as np
 import pytest
@@ -125,3 +127,23 @@ def test_outlier_edges_equal_the_command_line(tmp_path):
     assert cli["robust"] is True
     assert cli["outlier_edges"] == r.outlier_edges.tolist() == wrong.tolist()
     assert cli["certified"] == r.certified
+
+
+def test_ctrl_c_stops_a_robust_solve_whose_runs_go_at_once(tmp_path):
+    # A 10x10x10 cube with 30% wrong closures: ~2 s of GNC runs, two at once.
+    cube, corrupted = tmp_path / "cube.g2o", tmp_path / "corrupted.g2o"
+    g, _, _ = cs.generate_cube(side=10, seed=1)
+    cs.write_g2o(cube, g)
+    made = run_tool("generate", "outliers", cube, "--fraction", 0.3, "--seed", 1,
+                    "--output", corrupted)
+    assert made.returncode == 0, made.stderr
+    g = cs.read_g2o(corrupted)
+    main = threading.main_thread().ident
+    timer = threading.Timer(0.5, lambda: signal.pthread_kill(main, signal.SIGINT))
+    finished = False
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        cs.solve(g, robust=True, num_threads=2)
+        finished = True
+    timer.join()
+    assert not finished  # raised from inside the solve (from its GNC runs)
