@@ -726,14 +726,19 @@ TEST(RobustSolver, ExceptionsOfConcurrentRunsReachTheCaller) {
       thrown = true;
       throw std::runtime_error("from the second run");
     }
-    if (thrown) ++caller_calls_after;
+    if (thrown) {
+      ++caller_calls_after;
+      // Slow enough that the other run's exception surely unwinds (and
+      // cancels) within one of these iterations, however loaded the machine.
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
     return true;
   };
   RobustSolverSummary s;
   EXPECT_THROW(SolveRobust(corrupted, options, &s), std::runtime_error);
   // (Its iteration in progress when the other threw, and the next one's
-  // callback before its progress report.)
-  EXPECT_LE(caller_calls_after.load(), 2);
+  // callback before its progress report; 19-21 without the cancellation.)
+  EXPECT_LE(caller_calls_after.load(), 3);
 }
 
 // Two clusters joined only by two contradicting measurements, neither of
