@@ -730,7 +730,7 @@ TEST(RobustSolver, ExceptionsOfConcurrentRunsReachTheCaller) {
       ++caller_calls_after;
       // Slow enough that the other run's exception surely unwinds (and
       // cancels) within one of these iterations, however loaded the machine.
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     return true;
   };
