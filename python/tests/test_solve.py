@@ -178,7 +178,7 @@ def test_solve_releases_the_gil():
 
 
 def test_ctrl_c_stops_a_solve():
-    g = busy_graph(12, 3)  # ~0.5 s on one core, ranks up to 7
+    g = busy_graph(13, 3)  # ~0.9 s on one core
     start = time.monotonic()
     cs.solve(g, num_threads=1)
     uninterrupted = time.monotonic() - start
