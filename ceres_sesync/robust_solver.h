@@ -55,8 +55,9 @@
 // measurements are re-admitted where that lowers the TLS cost and they fit
 // at the accepted residuals' noise level (max_readmission_trials,
 // readmission_min_scale). GNC runs once per schedule of
-// gnc_threshold_fractions (g^2 = fraction * c^2); the result with the
-// lowest TLS cost is returned.
+// gnc_threshold_fractions (g^2 = fraction * c^2), the runs at once when
+// solver_options.num_threads allows; the result with the lowest TLS cost is
+// returned.
 //
 // What is certified, and what is not: the final SolverSummary certifies the
 // optimum of the problem restricted to the accepted edges (weights in {0, 1}
