@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -311,6 +312,7 @@ struct GncRun {
   // Seconds after the GNC steps: the inlier problem, the consistency rounds
   // and the re-admission trials.
   double inlier_time_s = 0;
+  int pattern_rebuilds = 0;  // Of the run's problem.
 };
 
 // sum_k min(f_k, c^2) over the estimated measurements plus f_k of the known
@@ -774,9 +776,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       internal::ResolveNumThreads(options.solver_options.num_threads);
   const int workers = static_cast<int>(
       std::min<size_t>(num_runs, static_cast<size_t>(threads)));
-  std::vector<GncRun> runs(num_runs);
-  std::vector<char> ran(num_runs, 0);
-  std::vector<int> rebuilds(num_runs, 0);
+  std::vector<std::optional<GncRun>> runs(num_runs);  // Empty: not run.
   std::mutex callback_mutex;
   // Set when a run has thrown: the others stop at their next progress report
   // (every trust-region iteration) by throwing RunCancelled.
@@ -805,20 +805,18 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       }
     }
     // Out of time: the runs so far (at least one) compete.
-    SolverOptions probe = base;
-    if (q > 0 && !budget(probe)) return;
-    const double fraction = options.gnc_threshold_fractions[q];
-    if (q == 0) {
-      first_options = base;
-      runs[q] = run_gnc(fraction, base, first_options, first_problem);
-    } else {
-      SolverOptions solve_options = base;
-      WeightedProblem problem(graph, solve_options);
-      runs[q] = run_gnc(fraction, base, solve_options, problem);
-      rebuilds[q] = problem.rebuilds();
-    }
-    runs[q].record.status = runs[q].status;
-    ran[q] = 1;
+    SolverOptions run_options = base;
+    if (q > 0 && !budget(run_options)) return;
+    std::optional<WeightedProblem> own;  // Built at the run's first step.
+    if (q > 0) own.emplace(graph, run_options);
+    if (q == 0) first_options = base;
+    SolverOptions& solve_options = own ? run_options : first_options;
+    WeightedProblem& problem = own ? *own : first_problem;
+    GncRun run = run_gnc(options.gnc_threshold_fractions[q], base,
+                         solve_options, problem);
+    run.record.status = run.status;
+    run.pattern_rebuilds = problem.rebuilds();
+    runs[q] = std::move(run);
   };
   {
     // An exception (std::bad_alloc, a throwing callback, Python's Ctrl-C
@@ -858,9 +856,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   GncRun best;
   int best_index = -1;
   for (size_t q = 0; q < num_runs; ++q) {
-    if (!ran[q]) continue;
-    GncRun& run = runs[q];
+    if (!runs[q]) continue;
+    GncRun& run = *runs[q];
     s.runs.push_back(run.record);
+    s.pattern_rebuilds += run.pattern_rebuilds;
     // A finished run beats one the time limit cut short (its verdicts are
     // rounded weights, its inlier problem unsolved), which beats a
     // disconnected one; then the lower TLS cost wins.
@@ -895,8 +894,6 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.weights_binary = best.weights_binary;
   s.message = best.message;
   s.inlier_summary = best.inlier_summary;
-  s.pattern_rebuilds = first_problem.rebuilds();
-  for (int r : rebuilds) s.pattern_rebuilds += r;
   FillEdges(graph, best.poses, best.weights, known, best.accepted, c2, &s);
   return finish(best.status, std::move(best.poses));
 }
