@@ -74,12 +74,14 @@ void TangentProjectionKernel(const double* y, const double* v, int r, int d,
   }
 }
 
-// TangentProjectionKernel<D> with the common staircase ranks r = d + 1 ..
-// d + 3 unrolled at compile time (the inner solver's most frequent call).
+// TangentProjectionKernel<D> with the common staircase ranks r = d .. d + 3
+// unrolled at compile time (the inner solver's most frequent call; r = d is
+// the first level's nonzero rows).
 template <int D>
 void TangentProjectionDispatch(const double* y, const double* v, int r, int d,
                                int n, double* out) {
   if constexpr (D != Eigen::Dynamic) {
+    if (r == D) return TangentProjectionKernel<D, D>(y, v, r, d, n, out);
     if (r == D + 1)
       return TangentProjectionKernel<D, D + 1>(y, v, r, d, n, out);
     if (r == D + 2)

@@ -241,14 +241,18 @@ TEST(SESyncProblem, RecoverTranslationsIsOptimalAndReproducesObjective) {
 TEST(SESyncProblem, BlockDiagonalMultiplyMatchesDense) {
   std::mt19937_64 rng(17);
   for (int d : {2, 3}) {
-    const int n = 7, r = 5;
-    const MatrixXd V = Gaussian(r, d * n, &rng);
-    const MatrixXd Lambda = Gaussian(d, d * n, &rng);
-    MatrixXd out;
-    internal::BlockDiagonalMultiply(V, Lambda, d, &out);
-    EXPECT_LT(
-        RelativeError(out, V * test_util::BlockDiagonalToDense(Lambda, d)),
-        1e-15);
+    // r = d .. d + 3 take the fixed-size kernels, d + 4 the dynamic one.
+    for (int r = d; r <= d + 4; ++r) {
+      const int n = 7;
+      const MatrixXd V = Gaussian(r, d * n, &rng);
+      const MatrixXd Lambda = Gaussian(d, d * n, &rng);
+      MatrixXd out;
+      internal::BlockDiagonalMultiply(V, Lambda, d, &out);
+      EXPECT_LT(
+          RelativeError(out, V * test_util::BlockDiagonalToDense(Lambda, d)),
+          1e-15)
+          << "d " << d << " r " << r;
+    }
   }
 }
 

@@ -516,6 +516,8 @@ void BlockDiagonalDispatch(const Eigen::MatrixXd& V,
                            int end, Eigen::MatrixXd* out) {
   if constexpr (D != Eigen::Dynamic) {
     switch (V.rows()) {
+      case D:
+        return BlockDiagonalKernel<D, D>(V, Lambda, d, begin, end, out);
       case D + 1:
         return BlockDiagonalKernel<D + 1, D>(V, Lambda, d, begin, end, out);
       case D + 2:

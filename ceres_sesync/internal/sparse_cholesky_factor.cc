@@ -587,12 +587,18 @@ void SparseCholeskyFactor::SolveRowsTail(const Eigen::MatrixXd& B, int offset,
   const int num_top = static_cast<int>(top_columns_.size());
   // W = B P^T (with zero leading columns), then the bins' accumulators.
   Eigen::MatrixXd W(r, n_ + num_bins * num_top);
+  // Column copies as plain loops: r is small (the rank), and Eigen's
+  // dynamic-length column assignment costs more in alignment handling than
+  // the copy itself (measured: ~5% of a 2D dataset's solve).
+  const std::ptrdiff_t ldr = r;
   for (int k = 0; k < n_; ++k) {
     const int source = permutation_[k] - offset;
+    double* w = W.data() + k * ldr;
     if (source >= 0) {
-      W.col(k) = B.col(source);
+      const double* b = B.data() + source * ldr;
+      for (int i = 0; i < r; ++i) w[i] = b[i];
     } else {
-      W.col(k).setZero();
+      for (int i = 0; i < r; ++i) w[i] = 0.0;
     }
   }
   W.rightCols(num_bins * num_top).setZero();
@@ -669,7 +675,10 @@ void SparseCholeskyFactor::SolveRowsTail(const Eigen::MatrixXd& B, int offset,
   }
   for (int k = 0; k < n_; ++k) {
     const int target = permutation_[k] - offset;
-    if (target >= 0) X->col(target) = W.col(k);
+    if (target < 0) continue;
+    const double* w = W.data() + k * ldr;
+    double* x = X->data() + target * ldr;
+    for (int i = 0; i < r; ++i) x[i] = w[i];
   }
 }
 
