@@ -46,12 +46,23 @@ int FindRoot(std::vector<int>& parent, int x) {
   return x;
 }
 
+template <int kD>
+bool IsRotationOfSize(const Eigen::MatrixXd& R, int d, double tolerance) {
+  using Matrix = Eigen::Matrix<double, kD, kD>;
+  const Matrix M = R;
+  const double orthogonality =
+      (M.transpose() * M - Matrix::Identity(d, d)).norm();
+  return orthogonality <= tolerance &&
+         std::abs(M.determinant() - 1) <= tolerance;
+}
+
 bool IsRotation(const Eigen::MatrixXd& R, int d, double tolerance) {
   if (R.rows() != d || R.cols() != d || !R.allFinite()) return false;
-  const double orthogonality =
-      (R.transpose() * R - Eigen::MatrixXd::Identity(d, d)).norm();
-  return orthogonality <= tolerance &&
-         std::abs(R.determinant() - 1) <= tolerance;
+  // Fixed sizes for d = 2, 3: no heap allocation and a closed-form
+  // determinant (this runs for every measurement of every solve).
+  if (d == 2) return IsRotationOfSize<2>(R, d, tolerance);
+  if (d == 3) return IsRotationOfSize<3>(R, d, tolerance);
+  return IsRotationOfSize<Eigen::Dynamic>(R, d, tolerance);
 }
 }  // namespace
 

@@ -49,7 +49,11 @@ Eigen::MatrixXd RoundSolution(const Eigen::MatrixXd& Y, int d) {
   const int n = static_cast<int>(Y.cols() / d);
   int negative = 0;
   for (int i = 0; i < n; ++i) {
-    if (R.middleCols(d * i, d).determinant() < 0) ++negative;
+    // Fixed sizes: a closed-form determinant, no LU with heap allocation.
+    const double det = d == 2   ? R.middleCols<2>(2 * i).determinant()
+                       : d == 3 ? R.middleCols<3>(3 * i).determinant()
+                                : R.middleCols(d * i, d).determinant();
+    if (det < 0) ++negative;
   }
   if (2 * negative > n) R.row(d - 1) *= -1;
   return ProjectBlocksToRotations(R, d);
