@@ -85,6 +85,10 @@ DEFINE_string(preconditioner, "auto",
               "SE-Sync's truncated-CG preconditioner: auto "
               "(SolverOptions::Preconditioner::kAutomatic, the default) or q "
               "(kRegularizedQ, the exact one alone), for A/B runs.");
+DEFINE_bool(near_convergence_tests, false,
+            "SE-Sync with SolverOptions::test_certificate_near_convergence "
+            "(stop the first level once its certificate is provable; off by "
+            "default), for A/B runs.");
 DEFINE_bool(sesync_only, false,
             "Run only SE-Sync (for peak-memory measurements with "
             "/usr/bin/time -v); same as --methods sesync.");
@@ -350,6 +354,8 @@ bool BenchDataset(const std::string& path, int repeats,
       sesync_options.preconditioner =
           SolverOptions::Preconditioner::kRegularizedQ;
     }
+    sesync_options.test_certificate_near_convergence =
+        FLAGS_near_convergence_tests;
     if (!RunSESync(graph, dataset, "SE-Sync", sesync_options, repeats,
                    /*extend=*/true, &sesync, &stage, &sesync_poses)) {
       return false;

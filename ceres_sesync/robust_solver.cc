@@ -366,6 +366,10 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // final inlier problem is solved with the caller's options again.
   // The Staircase reads its options at every stage.
   SolverOptions first_options = options.solver_options;
+  // The first solve and the GNC steps (below) run their descents to the
+  // local solver's tests: their poses seed GNC, their bounds are not
+  // reported.
+  first_options.test_certificate_near_convergence = false;
   // Gives the next solve the time left (options.max_time_s) and says whether
   // any is left. solve_options.max_time_s is the caller's per-solve limit
   // or what remains of the whole, the smaller (the Staircase counts from the
@@ -501,6 +505,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     double previous_cost = surrogate(mu);
     run.status = RobustSolverSummary::Status::kMaxIterations;
     solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
+    solve_options.test_certificate_near_convergence = false;
     if (options.gnc_relative_gradient_tolerance > 0) {
       solve_options.relative_preconditioned_gradient_tolerance =
           options.gnc_relative_gradient_tolerance;

@@ -669,6 +669,50 @@ TEST(SESyncSolver, CertificateTestsAfterAnEscapeStopTheDescentEarly) {
   EXPECT_GT(s_last.lower_bound, 0);
 }
 
+// SolverOptions::test_certificate_near_convergence: the first level (from
+// the chordal start, rank d) stops at the first test near convergence that
+// proves the verification's first proof, and the verification keeps it (no
+// further factorization: the same count as the converged run's). The poses
+// are less polished than the converged run's but proven within the goal:
+// both lower bounds hold for both objectives, and the dense certificate at
+// the returned rotations agrees.
+TEST(SESyncSolver, NearConvergenceTestsStopTheFirstLevelWithItsCertificate) {
+  // Precise measurements (kappa = tau = 10^3, 10^4): maps where double
+  // cannot reach the goal (the tests' domain), small enough for the dense
+  // check (dn = 512, 648).
+  const PoseGraph square = Cube(2, 16, 1e3, 1e3, 1, nullptr, 0.1);
+  const PoseGraph cube = Cube(3, 6, 1e4, 1e4, 1, nullptr, 0.1);
+  for (const PoseGraph* graph : std::vector<const PoseGraph*>{&square, &cube}) {
+    SCOPED_TRACE(graph->dimension);
+    SolverOptions off;
+    off.num_threads = 1;
+    SolverOptions on = off;
+    on.test_certificate_near_convergence = true;
+    SolverSummary s_on, s_off;
+    const Poses x_on = Solve(*graph, on, &s_on);
+    const Poses x_off = Solve(*graph, off, &s_off);
+    ASSERT_EQ(s_off.status, Status::kCertifiedOptimum) << s_off.FullReport();
+    ASSERT_EQ(s_on.status, Status::kCertifiedOptimum) << s_on.FullReport();
+    ASSERT_EQ(s_on.levels.size(), 1u) << s_on.FullReport();
+    const SolverSummary::Level& level = s_on.levels[0];
+    EXPECT_EQ(level.certificate_tests, 1);
+    EXPECT_TRUE(level.certificate_test_passed);
+    EXPECT_EQ(level.termination, "certificate test passed");
+    EXPECT_EQ(s_off.certificate_tests, 0);
+    EXPECT_LT(s_on.hessian_vector_products, s_off.hessian_vector_products);
+    EXPECT_EQ(s_on.factorizations, s_off.factorizations);
+    EXPECT_EQ(s_on.extended_factorizations, s_off.extended_factorizations);
+    EXPECT_LE(s_on.relative_suboptimality_bound, 1e-6);
+    EXPECT_LE(s_on.lower_bound, s_off.objective);
+    EXPECT_LE(s_off.lower_bound, s_on.objective);
+    EXPECT_NEAR(EvaluateObjective(*graph, x_on), s_on.objective,
+                1e-12 * s_on.objective);
+    double lmin = 0;
+    EXPECT_LE(DenseRelativeCertificateGap(*graph, x_on, &lmin), 1e-6)
+        << "dense lambda_min(S) = " << lmin;
+  }
+}
+
 // The same city's rank-4 saddle is a lifted rank-2 critical point (Y of
 // numerical rank 2), so its rounding is a critical point of the rank-2
 // problem, below the rounding of the rank-5 point. Round() refines from it:

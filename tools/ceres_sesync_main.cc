@@ -85,6 +85,7 @@ const std::vector<Command>& Commands() {
         {"local_solver"},
         {"gradient_tolerance"},
         {"test_certificate_after_escape"},
+        {"test_certificate_near_convergence"},
         {"max_time"},
         {"num_threads"},
         {"proof_arithmetic"},

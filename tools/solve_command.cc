@@ -39,6 +39,12 @@ DEFINE_bool(test_certificate_after_escape,
             "rank's optimization and stop it once the bound is provably "
             "within the tolerance (the poses are the same; the bound can be "
             "looser than after a converged descent).");
+DEFINE_bool(test_certificate_near_convergence,
+            ceres_sesync::SolverOptions().test_certificate_near_convergence,
+            "Test the certificate of a level started at rank d (the chordal "
+            "start) before its descent converges, once the gradient is "
+            "small, and stop it if the verification's first proof holds "
+            "(SolverOptions::test_certificate_near_convergence).");
 DEFINE_bool(components, false,
             "Solve a disconnected graph per connected component, each in its "
             "own gauge (its first pose, or its FIX pose, fixed); the report "
@@ -189,6 +195,8 @@ int RunSolve(const Args& args) {
   options.initial_rank = FLAGS_initial_rank;
   options.max_rank = FLAGS_max_rank;
   options.test_certificate_after_escape = FLAGS_test_certificate_after_escape;
+  options.test_certificate_near_convergence =
+      FLAGS_test_certificate_near_convergence;
   options.max_time_s = FLAGS_max_time;
   options.verbose = FLAGS_verbose;
   options.num_threads = FLAGS_num_threads;

@@ -152,11 +152,13 @@ class Staircase {
   double RemainingTime() const;
   // start + max_time_s, or time_point::max() for no limit.
   Clock::time_point Deadline() const;
-  // One level's local optimization (RTR or Ceres LBFGS) from Y; with
-  // test_certificate (a level entered by an escape, whose certificate is
-  // tested after it) it tests the certificate on the way
-  // (SolverOptions::test_certificate_after_escape).
-  void Optimize(int rank, bool test_certificate, Eigen::MatrixXd* Y,
+  // One level's local optimization (RTR or Ceres LBFGS) from Y. A level
+  // whose certificate is tested after it (`tested`) tests it on the way:
+  // entered by an escape, on the schedule of
+  // SolverOptions::test_certificate_after_escape; else, from a rank-d
+  // point, near convergence (SolverOptions::
+  // test_certificate_near_convergence).
+  void Optimize(int rank, bool escaped, bool tested, Eigen::MatrixXd* Y,
                 SolverSummary::Level* level);
   // The shift of a relative bound on the objective: relative_bound *
   // sdp_value / (d n), at least min_relative_eta's floor.
@@ -166,6 +168,14 @@ class Staircase {
   // Adds its factorizations to `level`; true iff it proved it.
   bool TestCertificate(double eta, ProofPrecision precision,
                        SolverSummary::Level* level);
+  // The test near convergence (SolverOptions::
+  // test_certificate_near_convergence) at the rank-d point Y with objective
+  // f: the first proof of the level's verification where that is in
+  // double-double (VerifyCertificate's step 1, with the translation spread of
+  // Y's rounding; none where it is in double). True iff it proved a shift
+  // within the goal's.
+  bool TestNearConvergence(const Eigen::MatrixXd& Y, double f,
+                           SolverSummary::Level* level);
   // The deferred double-double proof (see Report()).
   void TightenProof(const Eigen::MatrixXd& Y, double objective);
   // Keeps the last verified level's rounding (verified_rounding_) as
@@ -217,6 +227,9 @@ class Staircase {
   Eigen::MatrixXd passed_test_lambda_;
   double passed_test_shift_ = 0;
   ProofPrecision passed_test_precision_ = ProofPrecision::kDouble;
+  // Whether the level's verification may tighten that proof (not after a
+  // test near convergence: it was the verification's own first proof).
+  bool passed_test_tighten_ = true;
 };
 
 // A certificate test during the descent of a level entered by an escape

@@ -295,6 +295,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     // PlanDescentTest in staircase.h, is not repeated.)
     result.eta = options.known_shift;
     result.precision = options.known_precision;
+    if (!options.tighten_known_shift) return finish();
     const double start = std::max(
         {eta_target, 1.5 * double_floor, std::numeric_limits<double>::min()});
     if (first == ProofPrecision::kDouble && start < 0.5 * result.eta &&

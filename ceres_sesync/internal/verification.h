@@ -72,6 +72,10 @@ struct VerificationOptions {
   // estimate).
   double known_shift = std::numeric_limits<double>::infinity();
   ProofPrecision known_precision = ProofPrecision::kDouble;
+  // False: the known shift is the result as it stands (a test near
+  // convergence, SolverOptions::test_certificate_near_convergence, ran step
+  // 1's proof already; step 1 would stop there too).
+  bool tighten_known_shift = true;
   // No factorization is started that is predicted to end after this
   // (CertificateMatrix::PredictedSeconds), double-double ones stop at it,
   // and nothing starts once it has passed; the result then has out_of_time

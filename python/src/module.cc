@@ -203,6 +203,8 @@ void BindSolverOptions(py::module_& m) {
       .rw("min_relative_eta", &O::min_relative_eta)
       .rw("refine_rounded_solution", &O::refine_rounded_solution)
       .rw("test_certificate_after_escape", &O::test_certificate_after_escape)
+      .rw("test_certificate_near_convergence",
+          &O::test_certificate_near_convergence)
       .rw("num_threads", &O::num_threads)
       .rw("max_time_s", &O::max_time_s)
       .rw("verbose", &O::verbose)
