@@ -729,7 +729,12 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
     }
     largest *= 1 + 1e-12;
     if (largest <= 0.01 * passed_test_shift_) {
-      verification_options.known_shift = passed_test_shift_ + largest;
+      // Rounded up: the sum's own rounding must not lower the shift (exact,
+      // and as before, for the same Lambda).
+      verification_options.known_shift =
+          largest > 0 ? std::nextafter(passed_test_shift_ + largest,
+                                       std::numeric_limits<double>::infinity())
+                      : passed_test_shift_;
       verification_options.known_precision = passed_test_precision_;
       verification_options.tighten_known_shift = passed_test_tighten_;
     }
