@@ -691,6 +691,8 @@ bool Staircase::TestNearConvergence(const Eigen::MatrixXd& Y, double f,
                                       ProofPrecision::kDoubleDouble, level) &&
                       passed_test_shift_ <= goal;
   passed_test_tighten_ = false;
+  // A proof above the goal does not stop the level; it is not kept either.
+  if (!passed) passed_test_lambda_.resize(0, 0);
   return passed;
 }
 
