@@ -62,5 +62,37 @@ TEST(SolveCommand, NonExactRelaxationCertifiesWithinTheTolerance) {
   std::remove(json.c_str());
 }
 
+// --test_certificate_near_convergence reaches SolverOptions: on a precise
+// 16 x 16 grid (kappa = tau = 10^3, whose proof is in double-double) the
+// first level stops at one passed test, with fewer products than without
+// it, and the poses are certified either way.
+TEST(SolveCommand, NearConvergenceFlagStopsTheFirstLevelAtItsTest) {
+  if (!test_util::ToolBuilt()) GTEST_SKIP() << "the tool is not built";
+  const std::string graph = TempPath("grid16.g2o");
+  const std::string on = TempPath("grid16_on.json");
+  const std::string off = TempPath("grid16_off.json");
+  ASSERT_EQ(test_util::RunTool("generate cube --dimension 2 --side 16 "
+                               "--kappa 1000 --tau 1000 --seed 1 "
+                               "--loop_closure_probability 0.1 --output " +
+                               graph),
+            0);
+  ASSERT_EQ(
+      test_util::RunTool("solve " + graph +
+                         " --test_certificate_near_convergence --json " + on),
+      0);
+  ASSERT_EQ(test_util::RunTool("solve " + graph + " --json " + off), 0);
+  const std::string text_on = ReadFile(on), text_off = ReadFile(off);
+  EXPECT_NE(text_on.find("\"certified\": true"), std::string::npos);
+  EXPECT_NE(text_off.find("\"certified\": true"), std::string::npos);
+  EXPECT_EQ(JsonNumber(text_on, "certificate_tests"), 1) << text_on;
+  EXPECT_EQ(JsonNumber(text_off, "certificate_tests"), 0) << text_off;
+  EXPECT_LT(JsonNumber(text_on, "hessian_vector_products"),
+            JsonNumber(text_off, "hessian_vector_products"));
+  EXPECT_LE(JsonNumber(text_on, "relative_suboptimality_bound"), 1e-6);
+  std::remove(graph.c_str());
+  std::remove(on.c_str());
+  std::remove(off.c_str());
+}
+
 }  // namespace
 }  // namespace ceres_sesync
