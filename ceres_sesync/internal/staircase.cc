@@ -436,7 +436,7 @@ double Staircase::Shift(double relative_bound, double sdp_value) const {
 }
 
 bool Staircase::TestCertificate(double eta, ProofPrecision precision,
-                                SolverSummary::Level* level) {
+                                bool tighten, SolverSummary::Level* level) {
   const Clock::time_point deadline = Deadline();
   if (deadline != Clock::time_point::max() &&
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -454,6 +454,7 @@ bool Staircase::TestCertificate(double eta, ProofPrecision precision,
     passed_test_lambda_ = cost_->Lambda();
     passed_test_shift_ = certificate_->proven_shift();
     passed_test_precision_ = precision;
+    passed_test_tighten_ = tighten;
   }
   // Verify() factorizes again; only the symbolic analysis is kept meanwhile.
   certificate_->ReleaseFactor();
@@ -536,6 +537,15 @@ void Staircase::Optimize(int rank, bool escaped, bool tested,
       certificate_->factorization_flops() < kDoubleFirstMinFlops;
   int level_products = 0, last_test_products = 0;
   double test_seconds = 0;
+  // Runs a test (its time is verification's); the level stops if it passed.
+  auto run_test = [&](auto&& test) {
+    const auto test_start = Clock::now();
+    const bool passed = test();
+    test_seconds +=
+        std::chrono::duration<double>(Clock::now() - test_start).count();
+    level->certificate_test_passed = passed;
+    return !passed;
+  };
   rtr.callback = [&](int it, double f, double g, double radius, int products) {
     if (options_.verbose) {
       LOG(INFO) << "rank " << rank << " iter " << it << " F " << f << " |grad| "
@@ -546,20 +556,15 @@ void Staircase::Optimize(int rank, bool escaped, bool tested,
       return false;
     }
     if (test_near_convergence) {
+      // The verification's first double-double shift (VerifyCertificate).
+      const double eta =
+          std::max(Shift(options_.certification_target_relative_bound, f),
+                   Shift(options_.certification_goal_relative_bound, f) / 16);
       Eigen::MatrixXd gradient;
       cost.Gradient(&gradient);
-      if (!(gradient.norm() <=
-            kNearConvergenceRatio *
-                Shift(options_.certification_goal_relative_bound / 16, f))) {
-        return true;
-      }
+      if (!(gradient.norm() <= kNearConvergenceRatio * eta)) return true;
       test_near_convergence = false;  // One test per level.
-      const auto test_start = Clock::now();
-      const bool passed = TestNearConvergence(*Y, f, level);
-      test_seconds +=
-          std::chrono::duration<double>(Clock::now() - test_start).count();
-      level->certificate_test_passed = passed;
-      return !passed;
+      return run_test([&] { return TestNearConvergence(*Y, f, eta, level); });
     }
     if (!test_during) return true;
     level_products += products;
@@ -597,13 +602,9 @@ void Staircase::Optimize(int rank, bool escaped, bool tested,
     const int since = level_products - last_test_products;
     if (since < std::max(2 * cost, 0.25 * level_products)) return true;
     last_test_products = level_products;
-    const auto test_start = Clock::now();
-    const bool passed = TestCertificate(test.eta, test.precision, level);
-    passed_test_tighten_ = true;
-    test_seconds +=
-        std::chrono::duration<double>(Clock::now() - test_start).count();
-    level->certificate_test_passed = passed;
-    return !passed;
+    return run_test([&] {
+      return TestCertificate(test.eta, test.precision, /*tighten=*/true, level);
+    });
   };
   for (int pass = 0; pass < 3 && !use_ceres; ++pass) {
     const double floor = 1e-14 * scale_;
@@ -668,9 +669,8 @@ ProofPolicy ToPolicy(SolverOptions::ProofArithmetic arithmetic) {
 }  // namespace
 
 bool Staircase::TestNearConvergence(const Eigen::MatrixXd& Y, double f,
-                                    SolverSummary::Level* level) {
+                                    double eta, SolverSummary::Level* level) {
   // As in Verify() and VerifyCertificate's step 1.
-  const double target = Shift(options_.certification_target_relative_bound, f);
   const double goal = Shift(options_.certification_goal_relative_bound, f);
   translation_spread_ =
       TranslationSpread(problem_->RecoverTranslations(RoundSolution(Y, d_)),
@@ -687,10 +687,10 @@ bool Staircase::TestNearConvergence(const Eigen::MatrixXd& Y, double f,
       double_floor <= goal / 4) {
     return false;
   }
-  const bool passed = TestCertificate(std::max(target, goal / 16),
-                                      ProofPrecision::kDoubleDouble, level) &&
+  // Not tightened by the verification: it was the verification's own proof.
+  const bool passed = TestCertificate(eta, ProofPrecision::kDoubleDouble,
+                                      /*tighten=*/false, level) &&
                       passed_test_shift_ <= goal;
-  passed_test_tighten_ = false;
   // A proof above the goal does not stop the level; it is not kept either.
   if (!passed) passed_test_lambda_.resize(0, 0);
   return passed;

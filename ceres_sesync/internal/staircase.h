@@ -165,16 +165,18 @@ class Staircase {
   double Shift(double relative_bound, double sdp_value) const;
   // One certificate test at the current point of the cost: tries to prove
   // S + eta I >= 0 (not started if predicted to end after the time limit).
-  // Adds its factorizations to `level`; true iff it proved it.
-  bool TestCertificate(double eta, ProofPrecision precision,
+  // Adds its factorizations to `level`; true iff it proved it. A passed
+  // test is recorded for the level's verification (passed_test_*), which
+  // may tighten its proof iff `tighten`.
+  bool TestCertificate(double eta, ProofPrecision precision, bool tighten,
                        SolverSummary::Level* level);
   // The test near convergence (SolverOptions::
   // test_certificate_near_convergence) at the rank-d point Y with objective
-  // f: the first proof of the level's verification where that is in
-  // double-double (VerifyCertificate's step 1, with the translation spread of
-  // Y's rounding; none where it is in double). True iff it proved a shift
-  // within the goal's.
-  bool TestNearConvergence(const Eigen::MatrixXd& Y, double f,
+  // f: the first proof of the level's verification, at its shift eta, where
+  // that is in double-double (VerifyCertificate's step 1, with the
+  // translation spread of Y's rounding; none where it is in double). True iff
+  // it proved a shift within the goal's.
+  bool TestNearConvergence(const Eigen::MatrixXd& Y, double f, double eta,
                            SolverSummary::Level* level);
   // The deferred double-double proof (see Report()).
   void TightenProof(const Eigen::MatrixXd& Y, double objective);
