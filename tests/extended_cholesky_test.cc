@@ -545,5 +545,75 @@ TEST(ExtendedCholesky, RejectsIndefiniteMatrices) {
   }
 }
 
+// PermuteSymmetricPattern against a dense P A P^T: every entry on or below
+// A's diagonal lands once, at (min, max) of its pivots, with its value;
+// entries above the diagonal are skipped. Random patterns (both triangles,
+// and the lower one alone) and random permutations.
+TEST(ExtendedCholesky, PermuteSymmetricPatternMatchesDensePermutation) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 1 + trial * 3;
+    const bool lower_only = trial % 2 == 1;
+    std::uniform_real_distribution<double> uniform(0.5, 1.5);
+    std::vector<std::vector<double>> dense(n, std::vector<double>(n, 0.0));
+    for (int i = 0; i < n; ++i) {
+      dense[i][i] = uniform(rng);
+      for (int j = 0; j < i; ++j) {
+        if (rng() % 4 == 0) dense[i][j] = dense[j][i] = uniform(rng);
+      }
+    }
+    // Compressed columns of A (rows ascending).
+    std::vector<int> outer(1, 0), inner;
+    std::vector<double> value;
+    for (int c = 0; c < n; ++c) {
+      for (int r = lower_only ? c : 0; r < n; ++r) {
+        if (dense[r][c] != 0) {
+          inner.push_back(r);
+          value.push_back(dense[r][c]);
+        }
+      }
+      outer.push_back(static_cast<int>(inner.size()));
+    }
+    std::vector<int> ordering(n);
+    for (int k = 0; k < n; ++k) ordering[k] = k;
+    std::shuffle(ordering.begin(), ordering.end(), rng);
+    std::vector<int> position(n);
+    for (int k = 0; k < n; ++k) position[ordering[k]] = k;
+    const PermutedPattern p =
+        PermuteSymmetricPattern(n, outer.data(), inner.data(), position);
+    ASSERT_EQ(static_cast<int>(p.column_start.size()), n + 1);
+    ASSERT_EQ(p.slot.size(), inner.size());
+    std::vector<double> permuted(p.row_index.size(), 0.0);
+    std::vector<int> filled(p.row_index.size(), 0);
+    for (int c = 0; c < n; ++c) {
+      for (int q = outer[c]; q < outer[c + 1]; ++q) {
+        if (inner[q] < c) {
+          EXPECT_EQ(p.slot[q], -1);
+          continue;
+        }
+        ASSERT_GE(p.slot[q], 0);
+        permuted[p.slot[q]] = value[q];
+        ++filled[p.slot[q]];
+      }
+    }
+    EXPECT_TRUE(std::all_of(filled.begin(), filled.end(),
+                            [](int f) { return f == 1; }));
+    // The upper triangle of P A P^T, entry by entry.
+    int entries = 0;
+    for (int k = 0; k < n; ++k) {
+      for (int t = p.column_start[k]; t < p.column_start[k + 1]; ++t) {
+        const int row = p.row_index[t];
+        ASSERT_LE(row, k);
+        EXPECT_EQ(permuted[t], dense[ordering[row]][ordering[k]])
+            << "trial " << trial << " (" << row << ", " << k << ")";
+      }
+      for (int row = 0; row <= k; ++row) {
+        entries += dense[ordering[row]][ordering[k]] != 0;
+      }
+    }
+    EXPECT_EQ(entries, p.column_start[n]);
+  }
+}
+
 }  // namespace
 }  // namespace ceres_sesync::internal

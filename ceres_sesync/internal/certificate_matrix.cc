@@ -329,32 +329,13 @@ bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
 void CertificateMatrix::InitializePermutedPattern(
     std::vector<int>* permuted_start, std::vector<int>* permuted_row) {
   const int size = static_cast<int>(K_.rows());
-  std::vector<int>& position = position_;  // Original index -> pivot order.
-  position.resize(size);
-  for (int k = 0; k < size; ++k) position[ordering_[k]] = k;
-  // The permuted upper triangle: entry (r >= c) of K_ goes to column
-  // max(position) and row min(position).
-  std::vector<int>& start = *permuted_start;
-  start.assign(size + 1, 0);
-  const int* outer = K_.outerIndexPtr();
-  const int* inner = K_.innerIndexPtr();
-  for (int c = 0; c < size; ++c) {
-    for (int q = outer[c]; q < outer[c + 1]; ++q) {
-      ++start[std::max(position[inner[q]], position[c]) + 1];
-    }
-  }
-  for (int k = 0; k < size; ++k) start[k + 1] += start[k];
-  std::vector<int> next(start.begin(), start.end() - 1);
-  permuted_row->resize(K_.nonZeros());
-  permuted_index_.resize(K_.nonZeros());
-  for (int c = 0; c < size; ++c) {
-    for (int q = outer[c]; q < outer[c + 1]; ++q) {
-      const int pr = position[inner[q]], pc = position[c];
-      const int slot = next[std::max(pr, pc)]++;
-      (*permuted_row)[slot] = std::min(pr, pc);
-      permuted_index_[q] = slot;
-    }
-  }
+  position_.resize(size);  // Original index -> pivot order.
+  for (int k = 0; k < size; ++k) position_[ordering_[k]] = k;
+  PermutedPattern pattern = PermuteSymmetricPattern(
+      size, K_.outerIndexPtr(), K_.innerIndexPtr(), position_);
+  *permuted_start = std::move(pattern.column_start);
+  *permuted_row = std::move(pattern.row_index);
+  permuted_index_ = std::move(pattern.slot);
 }
 
 void CertificateMatrix::InitializeDoubleDouble() {

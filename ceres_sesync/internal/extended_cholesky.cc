@@ -1141,4 +1141,31 @@ void DoubleDoubleCholesky::ForEachSupernode(
   }
 }
 
+PermutedPattern PermuteSymmetricPattern(int n, const int* outer,
+                                        const int* inner,
+                                        const std::vector<int>& position) {
+  PermutedPattern p;
+  p.column_start.assign(n + 1, 0);
+  for (int c = 0; c < n; ++c) {
+    for (int q = outer[c]; q < outer[c + 1]; ++q) {
+      if (inner[q] < c) continue;
+      ++p.column_start[std::max(position[inner[q]], position[c]) + 1];
+    }
+  }
+  for (int k = 0; k < n; ++k) p.column_start[k + 1] += p.column_start[k];
+  std::vector<int> next(p.column_start.begin(), p.column_start.end() - 1);
+  p.row_index.resize(p.column_start[n]);
+  p.slot.assign(outer[n], -1);
+  for (int c = 0; c < n; ++c) {
+    for (int q = outer[c]; q < outer[c + 1]; ++q) {
+      if (inner[q] < c) continue;
+      const int pr = position[inner[q]], pc = position[c];
+      const int slot = next[std::max(pr, pc)]++;
+      p.row_index[slot] = std::min(pr, pc);
+      p.slot[q] = slot;
+    }
+  }
+  return p;
+}
+
 }  // namespace ceres_sesync::internal

@@ -246,6 +246,22 @@ class DoubleDoubleCholesky {
   bool timed_out_ = false;
 };
 
+// The input of DoubleDoubleCholesky::Analyze() for a symmetric n x n matrix A
+// permuted to P A P^T: A is given in compressed columns (outer, inner, both
+// triangles or only the lower one; entries above the diagonal are skipped)
+// and P by position[i] = the pivot (row of P A P^T) of A's row i. Entry
+// (r >= c) of A goes to column max(position[r], position[c]) and row
+// min(..) of the upper triangle; slot[q] is where A's stored entry q goes
+// (in row_index and so in the values Factorize() takes), -1 for a skipped
+// one. Rows within a column are in no particular order (Analyze() needs
+// none). O(n + nnz(A)).
+struct PermutedPattern {
+  std::vector<int> column_start, row_index, slot;
+};
+PermutedPattern PermuteSymmetricPattern(int n, const int* outer,
+                                        const int* inner,
+                                        const std::vector<int>& position);
+
 }  // namespace ceres_sesync::internal
 
 #endif  // CERES_SESYNC_INTERNAL_EXTENDED_CHOLESKY_H_
