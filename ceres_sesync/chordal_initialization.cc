@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <complex>
 #include <numeric>
 #include <vector>
 
 #include "ceres_sesync/internal/chordal.h"
+#include "ceres_sesync/internal/extended_cholesky.h"
 #include "ceres_sesync/internal/rounding.h"
 #include "ceres_sesync/internal/sesync_problem.h"
+#include "ceres_sesync/internal/sparse_cholesky_factor.h"
 #include "glog/logging.h"
 
 namespace ceres_sesync {
@@ -98,7 +101,8 @@ bool ComplexChordalSystem(const SparseMatrix& L,
 bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
                                    Eigen::MatrixXd* R,
                                    std::vector<int>* component,
-                                   const std::vector<int>* block_ordering) {
+                                   const std::vector<int>* block_ordering,
+                                   int num_threads) {
   const int dn = static_cast<int>(L.rows()), n = dn / d;
   // Components of the block graph: off-diagonal blocks with a nonzero entry.
   std::vector<int> parent(n);
@@ -196,24 +200,52 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
   }
   SparseMatrix L_ff(d * num_free, d * num_free);
   L_ff.setFromTriplets(triplets.begin(), triplets.end());
-  // Supernodal where the fill is heavy (large maps: 2.8e9 flops on a
-  // 10^5-pose city, 1.5 s against 2.5 s simplicial).
-  CholmodFactor factor;
-  ConfigureCholmod(CholmodLayout::kAutomatic, &factor);
+  const int size = d * num_free;
   std::vector<int> ordering;
-  ordering.reserve(d * block_order.size());
+  ordering.reserve(size);
   for (int k : block_order) {
     for (int a = 0; a < d; ++a) ordering.push_back(d * k + a);
   }
-  if (!ordering.empty()) {
-    factor.AnalyzePatternWithOrdering(L_ff, std::move(ordering));
-  } else {  // No ordering, or not of every free block: CHOLMOD's own.
-    factor.analyzePattern(L_ff);
+  if (ordering.empty()) {  // No ordering, or not of every free block.
+    CholmodFactor analysis;
+    ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
+    analysis.analyzePattern(L_ff);
+    ordering = analysis.Ordering();
   }
-  factor.factorize(L_ff);
-  if (factor.info() != Eigen::Success) return false;
-  const Eigen::MatrixXd X =
-      ProjectBlocksToRotations(factor.solve(rhs).transpose(), d);
+  // The project's supernodal Cholesky (extended_cholesky.h, in double) with
+  // the solves of sparse_cholesky_factor.h, not CHOLMOD: on sphere2500 and
+  // torus3D CHOLMOD's simplicial factorization was ~80% of this stage.
+  // Scaled by a power of two (exact) so that the pivots stay within the
+  // range the factorization accepts for any precisions.
+  std::vector<int> position(size);
+  for (int k = 0; k < size; ++k) position[ordering[k]] = k;
+  PermutedPattern pattern = PermuteSymmetricPattern(
+      size, L_ff.outerIndexPtr(), L_ff.innerIndexPtr(), position);
+  int exponent = 0;
+  std::frexp(L_ff.coeffs().cwiseAbs().maxCoeff(), &exponent);
+  std::vector<double> values(pattern.row_index.size());
+  for (int q = 0; q < L_ff.nonZeros(); ++q) {
+    if (pattern.slot[q] >= 0) {
+      values[pattern.slot[q]] = std::ldexp(L_ff.valuePtr()[q], -exponent);
+    }
+  }
+  DoubleDoubleCholesky::Options options;
+  options.num_threads = num_threads;
+  DoubleDoubleCholesky factor(options);
+  factor.Analyze(size, std::move(pattern.column_start),
+                 std::move(pattern.row_index));
+  if (!factor.Factorize(values)) return false;
+  const SparseCholeskyFactor solver(
+      std::move(ordering),
+      [&factor](const SparseCholeskyFactor::SupernodeVisitor& supernode) {
+        factor.ForEachSupernode(supernode);
+      });
+  // X^T = L_ff^{-1} rhs, i.e. X = rhs^T L_ff^{-1}; the scaling is undone on
+  // the right-hand side.
+  Eigen::MatrixXd X;
+  const Eigen::MatrixXd B = (rhs * std::ldexp(1.0, -exponent)).transpose();
+  solver.SolveRows(B, &X, num_threads);
+  X = ProjectBlocksToRotations(X, d);
   for (int i = 0; i < n; ++i) {
     if (free_index[i] >= 0) {
       R->middleCols(d * i, d) = X.middleCols(d * free_index[i], d);
@@ -231,7 +263,8 @@ bool ChordalRotations(const SESyncProblem& problem, Eigen::MatrixXd* R) {
     if (block >= 0) block_ordering.push_back(block);
   }
   if (!ChordalRotationsFromLaplacian(problem.RotationLaplacian(), d, R,
-                                     &component, &block_ordering)) {
+                                     &component, &block_ordering,
+                                     problem.num_threads())) {
     return false;
   }
   const int k = *std::max_element(component.begin(), component.end()) + 1;

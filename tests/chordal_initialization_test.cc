@@ -220,6 +220,35 @@ TEST(ChordalInitialization, BlockOrderingChangesOnlyRoundOff) {
   MatrixXd R;
   ASSERT_TRUE(internal::ChordalRotations(problem, &R));
   EXPECT_LT((R - reference).cwiseAbs().maxCoeff(), 1e-10);
+  // The factorization and solves split over threads: bitwise the same.
+  for (int threads : {2, 3}) {
+    MatrixXd R_threads;
+    ASSERT_TRUE(internal::ChordalRotationsFromLaplacian(
+        problem.RotationLaplacian(), d, &R_threads, nullptr, &vertex, threads));
+    MatrixXd R_one;
+    ASSERT_TRUE(internal::ChordalRotationsFromLaplacian(
+        problem.RotationLaplacian(), d, &R_one, nullptr, &vertex, 1));
+    EXPECT_EQ(R_threads, R_one) << threads << " threads";
+  }
+}
+
+// Precisions far from 1 (the factorization accepts pivots within 2^+-900):
+// rotation precisions scaled by 2^-950 scale L(G^rho) exactly, which the
+// chordal solve undoes, so the estimate is bitwise that of the unscaled
+// graph (3D: the real system; 2D cubes take the complex one).
+TEST(ChordalInitialization, TinyPrecisionsGiveTheSameEstimate) {
+  CubeOptions cube;
+  cube.side = 4;
+  cube.seed = 2;
+  PoseGraph graph;
+  ASSERT_TRUE(GenerateCube(cube, &graph, nullptr, nullptr));
+  PoseGraph tiny = graph;
+  for (auto& e : tiny.measurements) e.kappa = std::ldexp(e.kappa, -950);
+  MatrixXd R, R_tiny;
+  std::string error;
+  ASSERT_TRUE(ChordalRotations(graph, &R, &error)) << error;
+  ASSERT_TRUE(ChordalRotations(tiny, &R_tiny, &error)) << error;
+  EXPECT_EQ(R, R_tiny);
 }
 
 }  // namespace

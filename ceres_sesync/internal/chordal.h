@@ -19,11 +19,13 @@ namespace ceres_sesync::internal {
 // blocks; used only if it holds every free block), expanded to the free
 // blocks' entries, instead of CHOLMOD's own analysis (on a 10^5-pose city that
 // analysis, AMD then METIS on the dn scalar unknowns, took 2.0 s of the chordal
-// stage's 3.7 s). Returns false if the reduced Laplacian cannot be factorized.
+// stage's 3.7 s). The factorization and solves use up to `num_threads`
+// threads (the same results for every count). Returns false if the reduced
+// Laplacian cannot be factorized.
 bool ChordalRotationsFromLaplacian(
     const SparseMatrix& L, int d, Eigen::MatrixXd* R,
     std::vector<int>* component = nullptr,
-    const std::vector<int>* block_ordering = nullptr);
+    const std::vector<int>* block_ordering = nullptr, int num_threads = 1);
 
 // The chordal rotations of the problem (d x dn, n = num_rotations()). The
 // rotation graph may be disconnected where the whole problem is not: the
