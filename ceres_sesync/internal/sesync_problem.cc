@@ -230,10 +230,17 @@ std::vector<Triplet> VertexPattern(const PoseGraph& graph,
 // fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops (1.2x on
 // city10000 and a 27,000-pose cube). So METIS is tried when the predicted
 // flops of the augmented matrix exceed 2e4 per pose (about where its ~7 us
-// per pose pays off), and kept if it predicts fewer flops. The first
+// per pose pays off) on maps of at least kMinNestedDissectionVertices, and
+// kept if it predicts fewer flops. Below that size its gain is small and
+// did not pay for its ~2.5 us per vertex: sphere2500 and torus3D (the only
+// shared datasets above 2e4 per pose) got 11% and 19% fewer flops, and
+// their solves were 8% slower in all (one thread); a 20,000-pose city got
+// 2.1x fewer, and its solve was ~30% faster. The first
 // analysis is AMD alone: CHOLMOD's default would itself go on to METIS
 // when AMD's fill is heavy, which then ran twice (10^6-pose city: 9.9 s
 // for that analysis, 7.8 s for the second METIS).
+constexpr int kMinNestedDissectionVertices = 10000;
+
 std::vector<int> VertexOrdering(const PoseGraph& graph,
                                 const ProblemLayout& layout) {
   const int num_vertices = layout.num_vertices();
@@ -249,7 +256,8 @@ std::vector<int> VertexOrdering(const PoseGraph& graph,
   std::vector<int> ordering = analysis.Ordering();
   const double block_flops = std::pow(graph.dimension + 1.0, 3) / 2;
   const double flops = analysis.cholmod().fl;
-  if (flops * block_flops > 2e4 * num_vertices) {
+  if (num_vertices >= kMinNestedDissectionVertices &&
+      flops * block_flops > 2e4 * num_vertices) {
     CholmodFactor nested;
     ConfigureCholmod(CholmodLayout::kSimplicial, &nested);
     cholmod_common& common = nested.cholmod();
