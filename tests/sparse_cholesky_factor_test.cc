@@ -141,6 +141,31 @@ TEST(SparseCholeskyFactor, FromSupernodesMatchesDenseSolve) {
   const Eigen::MatrixXd dense =
       Eigen::MatrixXd(A).selfadjointView<Eigen::Lower>();
   for (int r = 1; r <= 7; ++r) ExpectSolvesMatchDense(solver, dense, r);
+
+  // RefreshValues: the factor of A + 3 I (same analysis) copied into this
+  // solver solves with A + 3 I, bitwise as a solver built from it.
+  std::vector<double> shifted = value;
+  for (int c = 0; c < n; ++c) {
+    for (int q = start[c]; q < start[c + 1]; ++q) {
+      if (row[q] == c) shifted[q] += 3;
+    }
+  }
+  ASSERT_TRUE(chol.Factorize(shifted));
+  auto supernodes = [&](const SparseCholeskyFactor::SupernodeVisitor& visit) {
+    chol.ForEachSupernode(visit);
+  };
+  SparseCholeskyFactor refreshed = solver;
+  refreshed.RefreshValues(supernodes);
+  const SparseCholeskyFactor fresh(ordering, supernodes);
+  const Eigen::MatrixXd dense_shifted =
+      dense + 3 * Eigen::MatrixXd::Identity(n, n);
+  for (int r = 1; r <= 3; ++r)
+    ExpectSolvesMatchDense(refreshed, dense_shifted, r);
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(2, n);
+  Eigen::MatrixXd x_refreshed, x_fresh;
+  refreshed.SolveRows(B, &x_refreshed);
+  fresh.SolveRows(B, &x_fresh);
+  EXPECT_EQ(x_refreshed, x_fresh);
 }
 
 // The certificate relies on the factorization failing for matrices that are

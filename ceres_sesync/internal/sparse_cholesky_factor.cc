@@ -123,6 +123,32 @@ SparseCholeskyFactor::SparseCholeskyFactor(
   BuildSchedule();
 }
 
+void SparseCholeskyFactor::RefreshValues(
+    const std::function<void(const SupernodeVisitor&)>& for_each_supernode) {
+  CHECK(!single_precision()) << "RefreshValues() of a single-precision factor";
+  size_t at = 0;
+  int s = 0;
+  for_each_supernode(
+      [&](int first, int c, const int*, int nrows, const double* x) {
+        CHECK(s < num_supernodes() && first_[s] == first &&
+              first_[s + 1] - first == c && rows_[s] == nrows - c)
+            << "RefreshValues() with other supernodes";
+        ++s;
+        auto value = [x, nrows](int i, int k) {
+          return x[i + static_cast<int64_t>(k) * nrows];
+        };
+        for (int k = 0; k < c; ++k) {  // As the constructor stores them.
+          for (int q = 0; q < k; ++q) values_[at++] = value(k, q);
+          values_[at++] = 1.0 / value(k, k);
+        }
+        for (int i = c; i < nrows; ++i) {
+          for (int k = 0; k < c; ++k) values_[at++] = value(i, k);
+        }
+      });
+  CHECK(s == num_supernodes() && at == values_.size())
+      << "RefreshValues() with other supernodes";
+}
+
 void SparseCholeskyFactor::Build(
     std::vector<int> permutation,
     const std::function<void(const ColumnVisitor&)>& for_each_column) {

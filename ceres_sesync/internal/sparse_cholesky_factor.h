@@ -69,6 +69,13 @@ class SparseCholeskyFactor {
       std::vector<int> permutation,
       const std::function<void(const SupernodeVisitor&)>& for_each_supernode);
 
+  // Replaces the values with those of a factor of the same supernodes
+  // (a numeric refactorization with the same analysis), given as for the
+  // constructor above, and keeps the rest: the solve schedule is not
+  // rebuilt. Not for a factor in single precision.
+  void RefreshValues(
+      const std::function<void(const SupernodeVisitor&)>& for_each_supernode);
+
   int size() const { return n_; }
   // X = B A^{-1} for B of size r x size(); X may not alias B. The r rows are
   // independent solves, split over up to `num_threads` threads.
