@@ -581,6 +581,43 @@ TEST(SESyncSolver, AutomaticPreconditionerSwitchesWhenBlockJacobiIsSlow) {
   EXPECT_GT(std::stoi(s.preconditioner.substr(prefix.size())), 20 * 7);
 }
 
+// The long trajectories whose first truncated-CG solves are long under
+// (Q + eps I)^-1 switch to the Newton preconditioner of the first level
+// (SolverOptions::newton_at_rank_d) and certify the same optimum (each
+// objective within its proven bound, both above both lower bounds) in far
+// fewer products.
+TEST(SESyncSolver, LongTrajectoriesSwitchToNewtonAtRankD) {
+  for (const char* file : {"parking-garage.g2o", "ais2klinik.g2o"}) {
+    PoseGraph graph;
+    if (!ReadDataset(file, &graph)) {
+      GTEST_SKIP() << "dataset absent: " << file << " in "
+                   << CERES_SESYNC_DATA_DIR;
+    }
+    SCOPED_TRACE(file);
+    SolverOptions o;
+    o.num_threads = 1;
+    SolverSummary newton, plain;
+    Solve(graph, o, &newton);
+    o.newton_at_rank_d = false;
+    Solve(graph, o, &plain);
+    ASSERT_EQ(newton.status, Status::kCertifiedOptimum) << newton.FullReport();
+    ASSERT_EQ(plain.status, Status::kCertifiedOptimum) << plain.FullReport();
+    EXPECT_NE(newton.preconditioner.find("Newton at rank d"), std::string::npos)
+        << newton.preconditioner;
+    EXPECT_EQ(plain.preconditioner.find("Newton"), std::string::npos);
+    EXPECT_LT(3 * newton.hessian_vector_products,
+              plain.hessian_vector_products);
+    for (const SolverSummary* a : {&newton, &plain}) {
+      for (const SolverSummary* b : {&newton, &plain}) {
+        EXPECT_LE(a->lower_bound, b->objective);
+      }
+    }
+    EXPECT_LE(std::abs(newton.objective - plain.objective),
+              std::max(newton.objective - newton.lower_bound,
+                       plain.objective - plain.lower_bound));
+  }
+}
+
 // A 1000-pose city at kappa 10 (seed 1), which has a rank-4 saddle.
 PoseGraph CityWithSaddle() {
   CityOptions city;

@@ -86,6 +86,7 @@ const std::vector<Command>& Commands() {
         {"gradient_tolerance"},
         {"test_certificate_after_escape"},
         {"test_certificate_near_convergence"},
+        {"newton_at_rank_d"},
         {"max_time"},
         {"num_threads"},
         {"proof_arithmetic"},

@@ -45,6 +45,10 @@ DEFINE_bool(test_certificate_near_convergence,
             "start) before its descent converges, once the gradient is "
             "small, and stop it if the verification's first proof holds "
             "(SolverOptions::test_certificate_near_convergence).");
+DEFINE_bool(newton_at_rank_d, ceres_sesync::SolverOptions().newton_at_rank_d,
+            "Let the first level switch to the Riemannian Hessian's inverse "
+            "as the truncated-CG preconditioner when its first solves are "
+            "long (SolverOptions::newton_at_rank_d).");
 DEFINE_bool(components, false,
             "Solve a disconnected graph per connected component, each in its "
             "own gauge (its first pose, or its FIX pose, fixed); the report "
@@ -197,6 +201,7 @@ int RunSolve(const Args& args) {
   options.test_certificate_after_escape = FLAGS_test_certificate_after_escape;
   options.test_certificate_near_convergence =
       FLAGS_test_certificate_near_convergence;
+  options.newton_at_rank_d = FLAGS_newton_at_rank_d;
   options.max_time_s = FLAGS_max_time;
   options.verbose = FLAGS_verbose;
   options.num_threads = FLAGS_num_threads;

@@ -11,6 +11,17 @@
 
 namespace ceres_sesync::internal {
 
+namespace {
+
+// The Newton preconditioner is switched to only in the first solves of a
+// rank-d solve: the truncated-CG solves grow as the tolerance tightens, so
+// the first ones tell whether the rest will be long (ais2klinik: 13, 17,
+// 124, 157, 152 products with (Q + eps I)^-1), and a later switch leaves
+// too few iterations to repay building the Newton system.
+constexpr int kNewtonSwitchSolves = 2;
+
+}  // namespace
+
 SESyncPreconditioner::SESyncPreconditioner(
     const SESyncProblem& problem, PreconditionerType type, double max_condition,
     CertificateMatrix* workspace, const PreconditionerSettings& settings)
@@ -150,6 +161,24 @@ SESyncCost::SESyncCost(const SESyncProblem* problem,
       preconditioner_(preconditioner),
       d_(problem->dimension()) {}
 
+void SESyncCost::EnableNewton(int switch_products) {
+  const bool supported =
+      problem_->num_translations() > 1 && (d_ == 2 || d_ == 3);
+  newton_switch_products_ = supported ? switch_products : -1;
+}
+
+void SESyncCost::BeginSolve(bool allow_newton) {
+  newton_allowed_ = allow_newton;
+  newton_active_ = false;
+  solves_ = 0;
+}
+
+void SESyncCost::ResetNewton() {
+  newton_.reset();
+  newton_active_ = false;
+  newton_failed_.resize(0, 0);
+}
+
 double SESyncCost::Evaluate(const Eigen::MatrixXd& Y) {
   // The buffers swap: no allocation once their shapes are set.
   Y_.swap(previous_Y_);
@@ -189,11 +218,49 @@ void SESyncCost::HessianVector(const Eigen::MatrixXd& V, Eigen::MatrixXd* hv) {
 }
 
 void SESyncCost::Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) {
+  if (newton_active_ && Y_.rows() == d_) {
+    auto equal = [](const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+      return A.rows() == B.rows() && A.cols() == B.cols() && A == B;
+    };
+    bool factorized = equal(newton_->point(), Y_);
+    if (!factorized && !equal(newton_failed_, Y_)) {
+      factorized = newton_->Factorize(Y_, lambda_, newton_eps_);
+      if (!factorized) newton_failed_ = Y_;
+    }
+    if (factorized) {
+      newton_->Apply(V, pv);
+      return;
+    }
+  }
   preconditioner_->Apply(V, &vq_);
   ProjectToStiefelProductTangent(Y_, vq_, d_, pv, problem_->num_threads());
 }
 
 bool SESyncCost::UpdatePreconditioner(int inner_iterations, bool converged) {
+  if (!converged) ++solves_;
+  if (!newton_active_ && newton_allowed_ && newton_switch_products_ >= 0 &&
+      Y_.rows() == d_ && !converged && solves_ <= kNewtonSwitchSolves &&
+      inner_iterations > newton_switch_products_) {
+    if (newton_ == nullptr) {
+      newton_ = std::make_unique<TangentNewton>(*problem_);
+      // The shift on the rotation unknowns removes the global rotation (the
+      // gauge: an exact null direction of the Hessian, which the gradient
+      // does not enter) and little else: 2e-10 times the Gershgorin bound
+      // on lambda_max(2D) (kitti_00 and ais2klinik: with 2e-6 the solves
+      // after the switch took 3-20 products each, with 2e-10 1-2).
+      const SparseMatrix& D = problem_->D();
+      Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(D.rows());
+      for (int k = 0; k < D.outerSize(); ++k) {
+        for (SparseMatrix::InnerIterator it(D, k); it; ++it) {
+          row_sums(it.row()) += std::abs(it.value());
+        }
+      }
+      newton_eps_ = 2e-10 * row_sums.maxCoeff();
+    }
+    newton_active_ = true;
+    return true;
+  }
+  if (newton_active_ && Y_.rows() == d_) return false;
   return preconditioner_->Update(inner_iterations, converged);
 }
 

@@ -9,6 +9,7 @@
 
 #include "ceres_sesync/internal/certificate_matrix.h"
 #include "ceres_sesync/internal/sesync_problem.h"
+#include "ceres_sesync/internal/tangent_newton.h"
 #include "ceres_sesync/riemannian_trust_region.h"
 
 namespace ceres_sesync::internal {
@@ -131,8 +132,24 @@ class SESyncCost : public RiemannianCostFunction {
                Eigen::MatrixXd* result) override;
   void ProjectToTangent(const Eigen::MatrixXd& V,
                         Eigen::MatrixXd* result) override;
-  // SESyncPreconditioner::Update (kAdaptive).
+  // SESyncPreconditioner::Update (kAdaptive), and the switch to the Newton
+  // preconditioner (EnableNewton).
   bool UpdatePreconditioner(int inner_iterations, bool converged) override;
+  // At rank d (Y_i in O(d)): switch to the exact inverse of the Riemannian
+  // Hessian in tangent coordinates (TangentNewton) when one of the first
+  // kNewtonSwitchSolves truncated-CG solves of a solve takes more than
+  // `switch_products` products (< 0: never).
+  void EnableNewton(int switch_products);
+  // Before each MinimizeRiemannianTrustRegion() with this cost: the switch
+  // above may happen in it (if allowed); the preconditioner starts as the
+  // SESyncPreconditioner.
+  void BeginSolve(bool allow_newton);
+  // Drops the Newton preconditioner (after the problem's weights changed).
+  void ResetNewton();
+  bool newton_active() const { return newton_active_; }
+  int newton_factorizations() const {
+    return newton_ ? newton_->factorizations() : 0;
+  }
   // F(Y') - F(Y) = <Y' - Y, (Y' + Y) Q> (Q symmetric) for the last two
   // evaluated points of the same shape, from their cached products with Q;
   // round-off 4 eps sum |Y' - Y| |(Y' + Y) Q| (elementwise; the products'
@@ -153,6 +170,17 @@ class SESyncCost : public RiemannianCostFunction {
   Eigen::MatrixXd previous_Y_, previous_YQ_;
   Eigen::MatrixXd vq_, v_lambda_;  // Workspace of HessianVector/Precondition.
   int hessian_vector_products_ = 0;
+  // The Newton preconditioner of rank-d levels (tangent_newton.h): allowed
+  // when newton_switch_products_ >= 0, active once a truncated-CG solve at
+  // rank d took more products than that; built then (its symbolic analysis)
+  // and refactorized at every new point. A point where it is not positive
+  // definite uses the preconditioner_ instead.
+  int newton_switch_products_ = -1;
+  bool newton_allowed_ = false, newton_active_ = false;
+  int solves_ = 0;  // Truncated-CG solves since BeginSolve().
+  double newton_eps_ = 0;
+  std::unique_ptr<TangentNewton> newton_;
+  Eigen::MatrixXd newton_failed_;  // Where the factorization failed last.
 };
 
 }  // namespace ceres_sesync::internal

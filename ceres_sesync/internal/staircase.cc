@@ -281,6 +281,25 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
         *problem_, choice.type, options_.regularized_cholesky_max_condition,
         certificate_.get(), choice.settings);
     cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
+    if (options_.newton_at_rank_d) {
+      // The Newton system's factorization in solves of its own factor: K's
+      // at rank d scaled to its blocks (2D: 3 unknowns per vertex, as K; 3D:
+      // 6 against 4: flops x 3.4, entries x 2.25), plus about one for its
+      // assembly and copy. A rank-d solve switches when one of its first two
+      // truncated-CG solves takes more than twice that in products
+      // (SESyncCost::EnableNewton). Measured (one thread): ais2klinik (13
+      // products in its first solve, threshold 5) and parking-garage (26,
+      // 11) switch, 4.6x and 1.7x faster; the other datasets' first solves
+      // take 1-10 products, under their thresholds (5-69), and a switch at
+      // their first solve was slower (kitti_00 0.83x, manhattan 0.82x,
+      // sphere2500 0.39x; city10000 1.14x faster).
+      const double scale = d_ == 3 ? 1.5 : 1.0;
+      const double cost =
+          scale * certificate_->FactorizationCostInSolves(d_) + 1;
+      cost_->EnableNewton(std::max(3, static_cast<int>(std::ceil(2 * cost))));
+      VLOG(1) << "Newton at rank d: factorization cost " << cost
+              << " solves, K's " << certificate_->FactorizationCostInSolves(d_);
+    }
   };
   if (parallel_window) {
     setup_pending_ = std::async(std::launch::async, prepare);
@@ -337,6 +356,7 @@ bool Staircase::Reweight(MeasurementWeights weights, Clock::time_point start) {
   }
   certificate_->Refresh();
   preconditioner_->Refresh();
+  cost_->ResetNewton();
   SetScales();
   verification_ = VerificationResult();
   sdp_value_ = lower_bound_ = 0;
@@ -613,6 +633,7 @@ void Staircase::Optimize(int rank, bool escaped, bool tested,
         std::sqrt(std::max(f, floor));
     rtr.max_time_s = RemainingTime();
     RiemannianTrustRegionSummary rtr_summary;
+    cost.BeginSolve(/*allow_newton=*/true);
     MinimizeRiemannianTrustRegion(rtr, &cost, Y, &rtr_summary);
     level->iterations += rtr_summary.iterations;
     level->hessian_vector_products += rtr_summary.hessian_vector_products;
@@ -856,6 +877,11 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     s.iterations += level.iterations;
     s.hessian_vector_products += level.hessian_vector_products;
     s.preconditioner = PreconditionerName(*preconditioner_);
+    if (cost_->newton_active()) {
+      s.preconditioner += "; Newton at rank d (" +
+                          std::to_string(cost_->newton_factorizations()) +
+                          " factorizations)";
+    }
     s.optimization_time_s += level.optimize_time_s;
     s.verification_time_s += level.verify_time_s;
     s.levels.push_back(level);
@@ -936,6 +962,8 @@ Solution Staircase::Round(const Eigen::MatrixXd& Y) {
           options_.relative_preconditioned_gradient_tolerance *
           std::sqrt(rounded);
       RiemannianTrustRegionSummary refine_summary;
+      // A refinement takes a step or two: not worth the Newton system.
+      cost_->BeginSolve(/*allow_newton=*/false);
       MinimizeRiemannianTrustRegion(rtr, cost_.get(), X, &refine_summary);
       s.iterations += refine_summary.iterations;
       s.hessian_vector_products += refine_summary.hessian_vector_products;

@@ -205,6 +205,7 @@ void BindSolverOptions(py::module_& m) {
       .rw("test_certificate_after_escape", &O::test_certificate_after_escape)
       .rw("test_certificate_near_convergence",
           &O::test_certificate_near_convergence)
+      .rw("newton_at_rank_d", &O::newton_at_rank_d)
       .rw("num_threads", &O::num_threads)
       .rw("max_time_s", &O::max_time_s)
       .rw("verbose", &O::verbose)
