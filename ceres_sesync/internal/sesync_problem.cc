@@ -234,8 +234,8 @@ std::vector<Triplet> VertexPattern(const PoseGraph& graph,
 // kept if it predicts fewer flops. Below that size its gain is small and
 // did not pay for its ~2.5 us per vertex: sphere2500 and torus3D (the only
 // shared datasets above 2e4 per pose) got 11% and 19% fewer flops, and
-// their solves were 8% slower in all (one thread); a 20,000-pose city got
-// 2.1x fewer, and its solve was ~30% faster. The first
+// their solves were 8% slower in all (one thread); from 2x10^4 poses on,
+// cities get 2.1-3x fewer. The first
 // analysis is AMD alone: CHOLMOD's default would itself go on to METIS
 // when AMD's fill is heavy, which then ran twice (10^6-pose city: 9.9 s
 // for that analysis, 7.8 s for the second METIS).
