@@ -7,14 +7,6 @@
 
 namespace ceres_sesync::internal {
 
-namespace {
-
-// Small dense blocks (at most 1 + d = 4 rows, d + d(d-1)/2 = 6 columns) on
-// the stack.
-using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
-
-}  // namespace
-
 TangentNewton::TangentNewton(const SESyncProblem& problem)
     : problem_(problem),
       d_(problem.dimension()),
@@ -189,11 +181,6 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
   cholesky_->Analyze(num_unknowns_, std::move(column_start),
                      std::move(row_index));
   values_.resize(slot_.size());
-}
-
-double TangentNewton::FactorizationCostInSolves() const {
-  return 2 * cholesky_->flops() /
-         (4.0 * d_ * std::max<double>(1, cholesky_->factor_nonzeros()));
 }
 
 template <int D>

@@ -44,11 +44,13 @@ class TangentNewton {
   const Eigen::MatrixXd& point() const { return Y_; }
   int factorizations() const { return factorizations_; }
 
-  // Two flops per multiply-add over the cost of a solve (two triangular
-  // solves of d rows), as CertificateMatrix::FactorizationCostInSolves.
-  double FactorizationCostInSolves() const;
-
  private:
+  // Fills values_ with H + eps (the rotation unknowns' diagonal) at Y, in
+  // the order of slot_; also sets rotated_.
+  template <int D>
+  void Assemble(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& Lambda,
+                double eps);
+
   const SESyncProblem& problem_;
   int d_, p_, n_, t0_;
   int num_unknowns_ = 0, rotation_offset_ = 0;
@@ -66,11 +68,8 @@ class TangentNewton {
   std::unique_ptr<DoubleDoubleCholesky> cholesky_;
   std::unique_ptr<SparseCholeskyFactor> solver_;
   Eigen::MatrixXd Y_;
-  Eigen::MatrixXd rotated_;  // Y_i E_k, d x d each.
-  std::vector<double> embedding_;
-  template <int D>
-  void Assemble(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& Lambda,
-                double eps);
+  Eigen::MatrixXd rotated_;        // Y_i E_k (d x d each) at the last Y.
+  std::vector<double> embedding_;  // Assemble()'s E_a of every vertex.
   int factorizations_ = 0;
 };
 
