@@ -336,7 +336,9 @@ struct SolverSummary {
   // The truncated-CG preconditioner the solve ended with (kAutomatic
   // resolved): "none", "block-Jacobi", "sparse Cholesky of D" or "exact
   // (Q + eps I)^-1"; when kAutomatic's block-Jacobi switched, "exact (Q +
-  // eps I)^-1 after N block-Jacobi iterations".
+  // eps I)^-1 after N block-Jacobi iterations". When the first level
+  // switched to the Newton preconditioner (newton_at_rank_d), followed by
+  // "; Newton at rank d (N factorizations)".
   std::string preconditioner;
   // Cholesky factorizations of the certificate matrix in verification
   // (certificate tests included), in double and in double-double, and the

@@ -147,6 +147,8 @@ class SESyncCost : public RiemannianCostFunction {
   // Drops the Newton preconditioner (after the problem's weights changed).
   void ResetNewton();
   bool newton_active() const { return newton_active_; }
+  // Factorizations of the Newton system since it was built (ResetNewton()
+  // drops it).
   int newton_factorizations() const {
     return newton_ ? newton_->factorizations() : 0;
   }

@@ -877,7 +877,7 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     s.iterations += level.iterations;
     s.hessian_vector_products += level.hessian_vector_products;
     s.preconditioner = PreconditionerName(*preconditioner_);
-    if (cost_->newton_active()) {
+    if (cost_->newton_factorizations() > 0) {
       s.preconditioner += "; Newton at rank d (" +
                           std::to_string(cost_->newton_factorizations()) +
                           " factorizations)";
