@@ -89,6 +89,13 @@ def test_options_by_keyword():
     assert options.as_dict()["max_rank"] == 7
     options.initialization = "vertices"
     assert options.initialization == cs.Initialization.vertices
+    # The Newton switch at rank d (on by default); the cube's first solves
+    # are short, so it does not switch and the results are the same.
+    assert cs.SolverOptions().newton_at_rank_d
+    assert not cs.SolverOptions(newton_at_rank_d=False).newton_at_rank_d
+    off = cs.solve(g, newton_at_rank_d=False)
+    assert off.certified and off.objective == cs.solve(g).objective
+    assert "Newton" not in off.preconditioner
 
 
 def test_option_errors():
