@@ -94,5 +94,38 @@ TEST(SolveCommand, NearConvergenceFlagStopsTheFirstLevelAtItsTest) {
   std::remove(off.c_str());
 }
 
+// --newton_at_rank_d reaches SolverOptions: parking-garage's first level
+// switches to the Newton preconditioner by default and not with the flag
+// off (fewer products with it), certified either way.
+TEST(SolveCommand, NewtonFlagControlsTheSwitchAtRankD) {
+  if (!test_util::ToolBuilt()) GTEST_SKIP() << "the tool is not built";
+  const std::string graph =
+      std::string(CERES_SESYNC_DATA_DIR) + "/parking-garage.g2o";
+  if (FILE* f = std::fopen(graph.c_str(), "r")) {
+    std::fclose(f);
+  } else {
+    GTEST_SKIP() << "dataset absent: " << graph;
+  }
+  const std::string on = TempPath("parking_on.json");
+  const std::string off = TempPath("parking_off.json");
+  ASSERT_EQ(
+      test_util::RunTool("solve " + graph + " --num_threads 1 --json " + on),
+      0);
+  ASSERT_EQ(test_util::RunTool("solve " + graph +
+                               " --num_threads 1 --newton_at_rank_d=false "
+                               "--json " +
+                               off),
+            0);
+  const std::string text_on = ReadFile(on), text_off = ReadFile(off);
+  EXPECT_NE(text_on.find("\"certified\": true"), std::string::npos);
+  EXPECT_NE(text_off.find("\"certified\": true"), std::string::npos);
+  EXPECT_NE(text_on.find("Newton at rank d"), std::string::npos) << text_on;
+  EXPECT_EQ(text_off.find("Newton"), std::string::npos) << text_off;
+  EXPECT_LT(JsonNumber(text_on, "hessian_vector_products"),
+            JsonNumber(text_off, "hessian_vector_products"));
+  std::remove(on.c_str());
+  std::remove(off.c_str());
+}
+
 }  // namespace
 }  // namespace ceres_sesync

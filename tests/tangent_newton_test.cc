@@ -153,7 +153,7 @@ TEST(TangentNewton, SwitchedDescentReachesTheSameMinimum) {
     rtr.preconditioned_gradient_tolerance = 0;
     rtr.step_tolerance = 0;
     std::vector<MatrixXd> minima;
-    std::vector<int> products, factorizations;
+    std::vector<int> products;
     for (const bool newton : {false, true}) {
       SESyncCost cost(&problem, &exact);
       cost.EnableNewton(newton ? 0 : -1);
@@ -168,7 +168,6 @@ TEST(TangentNewton, SwitchedDescentReachesTheSameMinimum) {
       EXPECT_EQ(cost.newton_active(), newton);
       minima.push_back(Y);
       products.push_back(summary.hessian_vector_products);
-      factorizations.push_back(cost.newton_factorizations());
       if (newton) {
         EXPECT_GT(cost.newton_factorizations(), 1);
         cost.BeginSolve(/*allow_newton=*/false);

@@ -230,9 +230,10 @@ std::vector<Triplet> VertexPattern(const PoseGraph& graph,
 // fill: measured on a 50,000-pose 2D city walk, 2.5x fewer flops (1.2x on
 // city10000 and a 27,000-pose cube). So METIS is tried when the predicted
 // flops of the augmented matrix exceed 2e4 per pose (about where its ~7 us
-// per pose pays off) on maps of at least kMinNestedDissectionVertices, and
-// kept if it predicts fewer flops. Below that size its gain is small and
-// did not pay for its ~2.5 us per vertex: sphere2500 and torus3D (the only
+// per pose, measured on large cities, pays off) on maps of at least
+// kMinNestedDissectionVertices, and kept if it predicts fewer flops. Below
+// that size its gain is small and did not pay for its cost (~2.5 us per
+// vertex there): sphere2500 and torus3D (the only
 // shared datasets above 2e4 per pose) got 11% and 19% fewer flops, and
 // their solves were 8% slower in all (one thread); from 2x10^4 poses on,
 // cities get 2.1-3x fewer. The first

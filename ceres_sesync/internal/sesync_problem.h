@@ -211,6 +211,8 @@ struct ProblemLayout {
     const int g = gauge();
     return k == g ? -1 : (k < g ? k : k - 1);
   }
+  // The translation node of index r in Lbar / Vbar (reduced()'s inverse).
+  int unreduced(int r) const { return r < gauge() ? r : r + 1; }
   // The vertex of translation node k (its own index) and of rotation block k.
   int vertex_of_rotation(int k) const {
     return k < num_poses ? k : num_poses + num_landmarks;

@@ -81,6 +81,28 @@ SparseCholeskyFactor::SparseCholeskyFactor(const cholmod_factor* factor,
   if (converted != nullptr) cholmod_free_factor(&converted, common);
 }
 
+namespace {
+
+// The stored values of a supernode of c columns and nrows rows given as
+// its nrows x c block x (column-major): the triangle row by row with the
+// reciprocal of each diagonal entry, then the rectangle row by row, each
+// passed to store(value) in that order.
+template <typename Store>
+void StoreSupernodeValues(int c, int nrows, const double* x, Store&& store) {
+  auto at = [x, nrows](int i, int k) {
+    return x[i + static_cast<int64_t>(k) * nrows];
+  };
+  for (int k = 0; k < c; ++k) {
+    for (int q = 0; q < k; ++q) store(at(k, q));
+    store(1.0 / at(k, k));
+  }
+  for (int i = c; i < nrows; ++i) {
+    for (int k = 0; k < c; ++k) store(at(i, k));
+  }
+}
+
+}  // namespace
+
 SparseCholeskyFactor::SparseCholeskyFactor(
     std::vector<int> permutation,
     const std::function<void(const SupernodeVisitor&)>& for_each_supernode) {
@@ -106,16 +128,8 @@ SparseCholeskyFactor::SparseCholeskyFactor(
         first_.push_back(first);
         rows_.push_back(nrows - c);
         row_index_.insert(row_index_.end(), rows + c, rows + nrows);
-        auto at = [x, nrows](int i, int k) {
-          return x[i + static_cast<int64_t>(k) * nrows];
-        };
-        for (int k = 0; k < c; ++k) {  // The triangle, row by row.
-          for (int q = 0; q < k; ++q) values_.push_back(at(k, q));
-          values_.push_back(1.0 / at(k, k));
-        }
-        for (int i = c; i < nrows; ++i) {  // The rectangle, row by row.
-          for (int k = 0; k < c; ++k) values_.push_back(at(i, k));
-        }
+        StoreSupernodeValues(c, nrows, x,
+                             [this](double v) { values_.push_back(v); });
       });
   CHECK_EQ(next, n_) << "supernodes do not cover the columns";
   stored_entries_ = num_values;
@@ -134,16 +148,8 @@ void SparseCholeskyFactor::RefreshValues(
               first_[s + 1] - first == c && rows_[s] == nrows - c)
             << "RefreshValues() with other supernodes";
         ++s;
-        auto value = [x, nrows](int i, int k) {
-          return x[i + static_cast<int64_t>(k) * nrows];
-        };
-        for (int k = 0; k < c; ++k) {  // As the constructor stores them.
-          for (int q = 0; q < k; ++q) values_[at++] = value(k, q);
-          values_[at++] = 1.0 / value(k, k);
-        }
-        for (int i = c; i < nrows; ++i) {
-          for (int k = 0; k < c; ++k) values_[at++] = value(i, k);
-        }
+        StoreSupernodeValues(c, nrows, x,
+                             [this, &at](double v) { values_[at++] = v; });
       });
   CHECK(s == num_supernodes() && at == values_.size())
       << "RefreshValues() with other supernodes";

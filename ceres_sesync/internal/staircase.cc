@@ -293,12 +293,11 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
       // take 1-10 products, under their thresholds (5-69), and a switch at
       // their first solve was slower (kitti_00 0.83x, manhattan 0.82x,
       // sphere2500 0.39x; city10000 1.14x faster).
-      const double scale = d_ == 3 ? 1.5 : 1.0;
-      const double cost =
-          scale * certificate_->FactorizationCostInSolves(d_) + 1;
+      const double k_cost = certificate_->FactorizationCostInSolves(d_);
+      const double cost = (d_ == 3 ? 1.5 : 1.0) * k_cost + 1;
       cost_->EnableNewton(std::max(3, static_cast<int>(std::ceil(2 * cost))));
       VLOG(1) << "Newton at rank d: factorization cost " << cost
-              << " solves, K's " << certificate_->FactorizationCostInSolves(d_);
+              << " solves, K's " << k_cost;
     }
   };
   if (parallel_window) {

@@ -19,52 +19,58 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
   // Unknowns: d per translation (of the reduced nodes), then p per rotation.
   rotation_offset_ = d * t0_;
   num_unknowns_ = rotation_offset_ + p * n_;
-  translation_of_vertex_.assign(vertices, -1);
-  rotation_of_vertex_.assign(vertices, -1);
-  std::vector<int> vertex_of_translation(t0_, -1), vertex_of_rotation(n_, -1);
+  translation_of_vertex_.resize(vertices);
+  rotation_of_vertex_.resize(vertices);
   for (int v = 0; v < vertices; ++v) {
     const int node = layout.translation_of_vertex(v);
-    if (node >= 0 && layout.reduced(node) >= 0) {
-      translation_of_vertex_[v] = layout.reduced(node);
-      vertex_of_translation[layout.reduced(node)] = v;
-    }
-    const int block = layout.rotation_of_vertex(v);
-    if (block >= 0) {
-      rotation_of_vertex_[v] = block;
-      vertex_of_rotation[block] = v;
-    }
+    translation_of_vertex_[v] = node >= 0 ? layout.reduced(node) : -1;
+    rotation_of_vertex_[v] = layout.rotation_of_vertex(v);
   }
-  // The vertex pairs (v >= w) of K_0's pattern, by w, then v: bucketed by
-  // w (a counting pass, then a fill), each bucket sorted and deduplicated.
+  // f(v, lv, w, lw, value) for every stored entry of K_0 without Lambda,
+  // (vertex, local index) of its row and of its column: local index 0 the
+  // translation, 1 + c the rotation's column c. Each is one entry of Lbar,
+  // Vbar (twice: K_0 holds -Vbar and -Vbar^T) or D. Translation node k is
+  // vertex k.
   const SparseMatrix& L = problem.Lbar();
   const SparseMatrix& V = problem.Vbar();
   const SparseMatrix& D = problem.D();
-  auto for_each_pair = [&](auto&& f) {
+  auto for_each_entry_of_k0 = [&](auto&& f) {
     for (int k = 0; k < L.outerSize(); ++k) {
       for (SparseMatrix::InnerIterator it(L, k); it; ++it) {
-        f(vertex_of_translation[it.row()], vertex_of_translation[k]);
+        f(layout.unreduced(it.row()), 0, layout.unreduced(k), 0, it.value());
       }
     }
     for (int k = 0; k < V.outerSize(); ++k) {
       for (SparseMatrix::InnerIterator it(V, k); it; ++it) {
-        f(vertex_of_translation[it.row()], vertex_of_rotation[k / d]);
+        const int vt = layout.unreduced(it.row());
+        const int vr = layout.vertex_of_rotation(k / d);
+        f(vt, 0, vr, 1 + k % d, -it.value());
+        f(vr, 1 + k % d, vt, 0, -it.value());
       }
     }
     for (int k = 0; k < D.outerSize(); ++k) {
       for (SparseMatrix::InnerIterator it(D, k); it; ++it) {
-        f(vertex_of_rotation[it.row() / d], vertex_of_rotation[k / d]);
+        f(layout.vertex_of_rotation(it.row() / d), 1 + it.row() % d,
+          layout.vertex_of_rotation(k / d), 1 + k % d, it.value());
       }
     }
-    for (int v = 0; v < vertices; ++v) f(v, v);
   };
+  // The vertex pairs (v >= w) of K_0's pattern and every diagonal pair, by
+  // w, then v: bucketed by w (a counting pass, then a fill), each bucket
+  // sorted and deduplicated.
   std::vector<int> bucket_start(vertices + 1, 0);
-  for_each_pair([&](int v, int w) { ++bucket_start[std::min(v, w) + 1]; });
+  for_each_entry_of_k0([&](int v, int, int w, int, double) {
+    ++bucket_start[std::min(v, w) + 1];
+  });
+  for (int v = 0; v < vertices; ++v) ++bucket_start[v + 1];
   for (int v = 0; v < vertices; ++v) bucket_start[v + 1] += bucket_start[v];
   std::vector<int> bucket(bucket_start.back());
   {
     std::vector<int> next(bucket_start.begin(), bucket_start.end() - 1);
-    for_each_pair(
-        [&](int v, int w) { bucket[next[std::min(v, w)]++] = std::max(v, w); });
+    for_each_entry_of_k0([&](int v, int, int w, int, double) {
+      bucket[next[std::min(v, w)]++] = std::max(v, w);
+    });
+    for (int v = 0; v < vertices; ++v) bucket[next[v]++] = v;
   }
   pair_start_.assign(vertices + 1, 0);
   for (int w = 0; w < vertices; ++w) {
@@ -79,43 +85,18 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
     pair_start_[w + 1] = static_cast<int>(pair_first_.size());
   }
   const size_t num_pairs = pair_first_.size();
-  auto pair_of = [&](int v, int w) {  // v >= w
-    const auto begin = pair_first_.begin() + pair_start_[w];
-    const auto end = pair_first_.begin() + pair_start_[w + 1];
-    const auto it = std::lower_bound(begin, end, v);
-    DCHECK(it != end && *it == v);
-    return static_cast<int>(it - pair_first_.begin());
-  };
-  // K_0's blocks without Lambda: local index 0 the translation, 1 + c the
-  // rotation's column c. Each entry of K_0 is one entry of Lbar, Vbar or D.
+  // K_0's (1 + d) x (1 + d) block of each pair, column-major.
   base_.assign(num_pairs * b * b, 0.0);
-  auto add = [&](int v, int lv, int w, int lw, double value) {
+  for_each_entry_of_k0([&](int v, int lv, int w, int lw, double value) {
     if (v < w) {
       std::swap(v, w);
       std::swap(lv, lw);
     }
-    base_[(pair_of(v, w) * b + lw) * b + lv] = value;  // Column-major.
-  };
-  for (int k = 0; k < L.outerSize(); ++k) {
-    for (SparseMatrix::InnerIterator it(L, k); it; ++it) {
-      add(vertex_of_translation[it.row()], 0, vertex_of_translation[k], 0,
-          it.value());
-    }
-  }
-  for (int k = 0; k < V.outerSize(); ++k) {
-    for (SparseMatrix::InnerIterator it(V, k); it; ++it) {
-      const int vt = vertex_of_translation[it.row()];
-      const int vr = vertex_of_rotation[k / d];
-      add(vt, 0, vr, 1 + k % d, -it.value());
-      add(vr, 1 + k % d, vt, 0, -it.value());
-    }
-  }
-  for (int k = 0; k < D.outerSize(); ++k) {
-    for (SparseMatrix::InnerIterator it(D, k); it; ++it) {
-      add(vertex_of_rotation[it.row() / d], 1 + it.row() % d,
-          vertex_of_rotation[k / d], 1 + k % d, it.value());
-    }
-  }
+    const auto begin = pair_first_.begin() + pair_start_[w];
+    const auto end = pair_first_.begin() + pair_start_[w + 1];
+    const auto pair = std::lower_bound(begin, end, v) - pair_first_.begin();
+    base_[(pair * b + lw) * b + lv] = value;
+  });
   // The unknowns of each vertex, and the elimination order: the vertices'
   // (problem.vertex_ordering()), each vertex's unknowns together.
   unknown_start_.assign(vertices + 1, 0);
