@@ -20,6 +20,16 @@ namespace {
 // too few iterations to repay building the Newton system.
 constexpr int kNewtonSwitchSolves = 2;
 
+// Used from the start (2D), the Newton factor of an earlier point stays the
+// preconditioner at a new point while the truncated-CG solves it
+// preconditions take at most this many products: near a minimum the Hessian
+// moves little between iterates, and a refactorization (with its assembly)
+// costs more than a few products. Products per rank-d solve, refactorized
+// at every point -> kept: kitti_00 7 -> 4 (5 -> 1 factorizations), intel
+// 5 -> 3, city10000 5 -> 4. After a switch (3D) the factor is renewed at
+// every point: kept there, parking-garage took 56 -> 60 products.
+constexpr int kNewtonStaleProducts = 2;
+
 // Gershgorin bound on lambda_max(A): its largest absolute row sum.
 double GershgorinBound(const SparseMatrix& A) {
   Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(A.rows());
@@ -30,6 +40,14 @@ double GershgorinBound(const SparseMatrix& A) {
   }
   return A.rows() > 0 ? row_sums.maxCoeff() : 0.0;
 }
+
+// The Newton system's shift on the rotation unknowns: it removes the global
+// rotation (the gauge: an exact null direction of the Hessian, which the
+// gradient does not enter) and little else: 2e-10 times the Gershgorin
+// bound on lambda_max(D), 2e-4 of the exact preconditioner's eps (kitti_00
+// and ais2klinik: with 2e-6 times the bound the solves after the switch took
+// 3-20 products each, with 2e-10 1-2).
+double NewtonShift(const SparseMatrix& D) { return 2e-10 * GershgorinBound(D); }
 
 }  // namespace
 
@@ -165,21 +183,39 @@ SESyncCost::SESyncCost(const SESyncProblem* problem,
       preconditioner_(preconditioner),
       d_(problem->dimension()) {}
 
-void SESyncCost::EnableNewton(int switch_products) {
+void SESyncCost::EnableNewton(int switch_products, bool from_start,
+                              bool exact_fallback) {
   const bool supported =
       problem_->num_translations() > 1 && (d_ == 2 || d_ == 3);
   newton_switch_products_ = supported ? switch_products : -1;
+  newton_from_start_ = supported && from_start;
+  newton_exact_fallback_ = exact_fallback;
+  if (!supported && exact_fallback) preconditioner_->SwitchToExact();
+}
+
+void SESyncCost::ProvideNewton(std::unique_ptr<TangentNewton> newton) {
+  if (!newton_from_start_ || newton_ != nullptr) return;
+  newton_ = std::move(newton);
+  newton_eps_ = NewtonShift(problem_->D());
 }
 
 void SESyncCost::BeginSolve(bool allow_newton) {
   newton_allowed_ = allow_newton;
   newton_active_ = false;
   solves_ = 0;
+  if (newton_from_start_) {
+    if (newton_ == nullptr) {
+      newton_ = std::make_unique<TangentNewton>(*problem_);
+      newton_eps_ = NewtonShift(problem_->D());
+    }
+    newton_active_ = true;
+  }
 }
 
 void SESyncCost::ResetNewton() {
   newton_.reset();
   newton_active_ = false;
+  last_solve_products_ = std::numeric_limits<int>::max();
   newton_failed_.resize(0, 0);
 }
 
@@ -227,6 +263,11 @@ void SESyncCost::Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) {
       return A.rows() == B.rows() && A.cols() == B.cols() && A == B;
     };
     bool factorized = equal(newton_->point(), Y_);
+    if (!factorized && newton_from_start_ && newton_->point().size() > 0 &&
+        last_solve_products_ <= kNewtonStaleProducts) {
+      newton_->Rebase(Y_);
+      factorized = true;
+    }
     if (!factorized && !equal(newton_failed_, Y_)) {
       factorized = newton_->Factorize(Y_, lambda_, newton_eps_);
       if (!factorized) newton_failed_ = Y_;
@@ -236,24 +277,21 @@ void SESyncCost::Precondition(const Eigen::MatrixXd& V, Eigen::MatrixXd* pv) {
       return;
     }
   }
+  if (newton_exact_fallback_) preconditioner_->SwitchToExact();
+  ++preconditioner_applications_;
   preconditioner_->Apply(V, &vq_);
   ProjectToStiefelProductTangent(Y_, vq_, d_, pv, problem_->num_threads());
 }
 
 bool SESyncCost::UpdatePreconditioner(int inner_iterations, bool converged) {
   if (!converged) ++solves_;
+  last_solve_products_ = inner_iterations;
   if (!newton_active_ && newton_allowed_ && newton_switch_products_ >= 0 &&
       Y_.rows() == d_ && !converged && solves_ <= kNewtonSwitchSolves &&
       inner_iterations > newton_switch_products_) {
     if (newton_ == nullptr) {
       newton_ = std::make_unique<TangentNewton>(*problem_);
-      // The shift on the rotation unknowns removes the global rotation (the
-      // gauge: an exact null direction of the Hessian, which the gradient
-      // does not enter) and little else: 2e-10 times the Gershgorin bound
-      // on lambda_max(D), 2e-4 of the exact preconditioner's eps (kitti_00
-      // and ais2klinik: with 2e-6 times the bound the solves after the
-      // switch took 3-20 products each, with 2e-10 1-2).
-      newton_eps_ = 2e-10 * GershgorinBound(problem_->D());
+      newton_eps_ = NewtonShift(problem_->D());
     }
     newton_active_ = true;
     return true;

@@ -5,6 +5,7 @@
 #ifndef CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 #define CERES_SESYNC_INTERNAL_SESYNC_COST_H_
 
+#include <limits>
 #include <memory>
 
 #include "ceres_sesync/internal/certificate_matrix.h"
@@ -135,16 +136,24 @@ class SESyncCost : public RiemannianCostFunction {
   // SESyncPreconditioner::Update (kAdaptive), and the switch to the Newton
   // preconditioner (EnableNewton).
   bool UpdatePreconditioner(int inner_iterations, bool converged) override;
-  // At rank d (Y_i in O(d)): switch to the exact inverse of the Riemannian
-  // Hessian in tangent coordinates (TangentNewton) when one of the first
+  // At rank d (Y_i in O(d)): use the exact inverse of the Riemannian
+  // Hessian in tangent coordinates (TangentNewton) from the start of every
+  // solve if `from_start`, else switch to it when one of the first
   // kNewtonSwitchSolves truncated-CG solves of a solve takes more than
-  // `switch_products` products (< 0: never).
-  void EnableNewton(int switch_products);
+  // `switch_products` products (< 0: never). With `exact_fallback`, a point
+  // where it cannot be used makes the SESyncPreconditioner exact first
+  // (SwitchToExact(): a kAdaptive one chosen lazily in its place).
+  void EnableNewton(int switch_products, bool from_start = false,
+                    bool exact_fallback = false);
+  // The Newton system built ahead (on this problem) for the use from the
+  // start; ignored unless that is enabled and none was built yet.
+  void ProvideNewton(std::unique_ptr<TangentNewton> newton);
   // Before each MinimizeRiemannianTrustRegion() with this cost: the switch
   // above may happen in it (if allowed); the preconditioner starts as the
-  // SESyncPreconditioner.
+  // SESyncPreconditioner unless Newton is used from the start.
   void BeginSolve(bool allow_newton);
-  // Drops the Newton preconditioner (after the problem's weights changed).
+  // Drops the Newton preconditioner (after the problem's weights changed;
+  // it is rebuilt when next used).
   void ResetNewton();
   bool newton_active() const { return newton_active_; }
   // Factorizations of the Newton system since it was built (ResetNewton()
@@ -162,6 +171,10 @@ class SESyncCost : public RiemannianCostFunction {
   // current point.
   const Eigen::MatrixXd& Lambda() const { return lambda_; }
   int hessian_vector_products() const { return hessian_vector_products_; }
+  // Precondition() calls that applied the SESyncPreconditioner (not Newton).
+  int preconditioner_applications() const {
+    return preconditioner_applications_;
+  }
 
  private:
   const SESyncProblem* problem_;
@@ -172,14 +185,21 @@ class SESyncCost : public RiemannianCostFunction {
   Eigen::MatrixXd previous_Y_, previous_YQ_;
   Eigen::MatrixXd vq_, v_lambda_;  // Workspace of HessianVector/Precondition.
   int hessian_vector_products_ = 0;
+  int preconditioner_applications_ = 0;
   // The Newton preconditioner of rank-d levels (tangent_newton.h): allowed
-  // when newton_switch_products_ >= 0, active once a truncated-CG solve at
-  // rank d took more products than that; built then (its symbolic analysis)
-  // and refactorized at every new point. A point where it is not positive
-  // definite uses the preconditioner_ instead.
+  // when newton_switch_products_ >= 0, active from the start of a solve
+  // (newton_from_start_) or once a truncated-CG solve at rank d took more
+  // products than that; built then (its symbolic analysis). At a new point
+  // it is refactorized only if the last truncated-CG solve took more than
+  // kNewtonStaleProducts products, else its factor is kept and only its
+  // tangent basis moves (TangentNewton::Rebase). A point where it is not
+  // positive definite uses the preconditioner_ instead.
   int newton_switch_products_ = -1;
+  bool newton_from_start_ = false, newton_exact_fallback_ = false;
   bool newton_allowed_ = false, newton_active_ = false;
   int solves_ = 0;  // Truncated-CG solves since BeginSolve().
+  // Products of the last truncated-CG solve (of this or an earlier solve).
+  int last_solve_products_ = std::numeric_limits<int>::max();
   double newton_eps_ = 0;
   std::unique_ptr<TangentNewton> newton_;
   Eigen::MatrixXd newton_failed_;  // Where the factorization failed last.

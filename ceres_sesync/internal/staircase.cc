@@ -13,6 +13,7 @@
 #include "ceres_sesync/internal/objective_bound.h"
 #include "ceres_sesync/internal/parallel.h"
 #include "ceres_sesync/internal/rounding.h"
+#include "ceres_sesync/internal/tangent_newton.h"
 #include "ceres_sesync/riemannian_trust_region.h"
 #include "ceres_sesync/stiefel_manifold.h"
 #include "glog/logging.h"
@@ -81,17 +82,24 @@ constexpr double kBlockJacobiBudget = 20;
 struct PreconditionerChoice {
   PreconditionerType type;
   PreconditionerSettings settings;
+  bool exact = false;  // (Q + eps I)^-1 chosen (kAdaptive: when first used).
 };
 
 PreconditionerChoice ChoosePreconditioner(const SolverOptions& options,
-                                          const CertificateMatrix& K, int r0) {
+                                          const CertificateMatrix& K, int r0,
+                                          bool newton_from_start) {
   PreconditionerChoice choice{ToInternal(options.preconditioner), {}};
   if (options.preconditioner != SolverOptions::Preconditioner::kAutomatic) {
     return choice;
   }
   const double ratio = K.FactorizationCostInSolves(r0);
   if (!(ratio > kDenseFactorSolves)) {
-    choice.type = PreconditionerType::kRegularizedQ;
+    // With the Newton preconditioner at rank d from the start, K_eps is
+    // factorized only where it is used: above rank d, or where Newton cannot
+    // be (SESyncCost's exact fallback makes this kAdaptive exact then).
+    choice.type = newton_from_start ? PreconditionerType::kAdaptive
+                                    : PreconditionerType::kRegularizedQ;
+    choice.exact = true;
     return choice;
   }
   choice.type = PreconditionerType::kAdaptive;
@@ -114,10 +122,13 @@ std::string PreconditionerName(const SESyncPreconditioner& p) {
     case PreconditionerType::kRegularizedQ:
       return "exact (Q + eps I)^-1";
     case PreconditionerType::kAdaptive:
-      return p.exact() ? "exact (Q + eps I)^-1 after " +
-                             std::to_string(p.block_jacobi_iterations()) +
-                             " block-Jacobi iterations"
-                       : "block-Jacobi";
+      if (!p.exact()) return "block-Jacobi";
+      // Made exact before block-Jacobi ran (at an escape, or standing in
+      // lazily for the Newton system): the exact one alone.
+      if (p.block_jacobi_iterations() == 0) return "exact (Q + eps I)^-1";
+      return "exact (Q + eps I)^-1 after " +
+             std::to_string(p.block_jacobi_iterations()) +
+             " block-Jacobi iterations";
   }
   return "";
 }
@@ -266,11 +277,20 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     s.message = kLbarNotPositiveDefinite;
     return;
   }
+  // In 2D the Newton system has K's size (3 unknowns per vertex) and, used
+  // from the first solve, takes 2-4 products per rank-d solve (kitti_00 22
+  // -> 4, intel 23 -> 3, city10000 100 -> 4) with a factorization or two:
+  // faster than (Q + eps I)^-1, whose factorization is then skipped unless
+  // a higher rank needs it. In 3D H has 3.4x K's flops, and the switch rule
+  // below decides. (A random start is not at rank d.)
+  newton_from_start_ =
+      options.newton_at_rank_d && d_ == 2 &&
+      options.initialization != SolverOptions::Initialization::kRandom;
   auto prepare = [this] {
     if (!problem_->ok()) return;  // Initialize() reports it.
     certificate_ = std::make_unique<CertificateMatrix>(*problem_);
     const PreconditionerChoice choice =
-        ChoosePreconditioner(options_, *certificate_, r0_);
+        ChoosePreconditioner(options_, *certificate_, r0_, newton_from_start_);
     // kAdaptive switches in the first level (no certificate tests run
     // during its optimization) or at an escape (between levels), so
     // certificate_ is free then to serve as its workspace, as for
@@ -282,20 +302,24 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
         certificate_.get(), choice.settings);
     cost_ = std::make_unique<SESyncCost>(problem_.get(), preconditioner_.get());
     if (options_.newton_at_rank_d) {
-      // The Newton system's factorization in solves of its own factor: K's
-      // at rank d scaled to its blocks (2D: 3 unknowns per vertex, as K; 3D:
-      // 6 against 4: flops x 3.4, entries x 2.25), plus about one for its
-      // assembly and copy. A rank-d solve switches when one of its first two
-      // truncated-CG solves takes more than twice that in products
-      // (SESyncCost::EnableNewton). Measured (one thread): ais2klinik (13
-      // products in its first solve, threshold 5) and parking-garage (26,
-      // 11) switch, 4.6x and 1.7x faster; the other datasets' first solves
-      // take 1-10 products, under their thresholds (5-69), and a switch at
-      // their first solve was slower (kitti_00 0.83x, manhattan 0.82x,
-      // sphere2500 0.39x; city10000 1.14x faster).
+      // 2D: from the start (above). 3D: the Newton system's factorization
+      // in solves of its own factor: K's at rank d scaled to its blocks (6
+      // unknowns per vertex against 4: flops x 3.4, entries x 2.25), plus
+      // about one for its assembly and copy. A rank-d solve switches when
+      // one of its first two truncated-CG solves takes more than twice that
+      // in products (SESyncCost::EnableNewton). Measured (one thread, before
+      // 2D started with it): parking-garage (26 products in its first
+      // solve, threshold 11) and ais2klinik (13, 5) switched, 1.7x and 4.6x
+      // faster; the other datasets' first solves took 1-10 products, under
+      // their thresholds (5-69), and a switch at the first solve was slower
+      // in 3D (sphere2500 0.39x, torus3D 0.29x, cubicle 0.63x) and, with a
+      // refactorization at every iterate, in 2D too (kitti_00 0.83x).
       const double k_cost = certificate_->FactorizationCostInSolves(d_);
       const double cost = (d_ == 3 ? 1.5 : 1.0) * k_cost + 1;
-      cost_->EnableNewton(std::max(3, static_cast<int>(std::ceil(2 * cost))));
+      cost_->EnableNewton(std::max(3, static_cast<int>(std::ceil(2 * cost))),
+                          newton_from_start_,
+                          /*exact_fallback=*/choice.exact &&
+                              choice.type == PreconditionerType::kAdaptive);
       VLOG(1) << "Newton at rank d: factorization cost " << cost
               << " solves, K's " << k_cost;
     }
@@ -437,6 +461,13 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
     }
     Y->topRows(d) = R;
   }
+  // The Newton system's symbolic analysis needs only the data matrices: on
+  // this thread while the set-up finishes on the other (with one thread
+  // the same work, counted here instead of in the first solve).
+  std::unique_ptr<TangentNewton> newton;
+  if (newton_from_start_ && problem_->num_translations() > 1) {
+    newton = std::make_unique<TangentNewton>(*problem_);
+  }
   AwaitSetup();
   if (!problem_->ok()) {  // Lbar's factorization ran in the background.
     s.status = SolverSummary::Status::kInvalidInput;
@@ -444,6 +475,7 @@ bool Staircase::Initialize(const Poses* initial, Eigen::MatrixXd* Y) {
     ok_ = false;
     return false;
   }
+  if (newton) cost_->ProvideNewton(std::move(newton));
   s.initialization_time_s =
       std::chrono::duration<double>(Clock::now() - t).count();
   return true;
@@ -875,11 +907,17 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     s.extended_proof_time_s += verification_.extended_time_s;
     s.iterations += level.iterations;
     s.hessian_vector_products += level.hessian_vector_products;
-    s.preconditioner = PreconditionerName(*preconditioner_);
-    if (cost_->newton_factorizations() > 0) {
-      s.preconditioner += "; Newton at rank d (" +
-                          std::to_string(cost_->newton_factorizations()) +
-                          " factorizations)";
+    // What preconditioned the products: the SESyncPreconditioner where it
+    // was applied, the Newton system where it was factorized.
+    const std::string newton = "Newton at rank d (" +
+                               std::to_string(cost_->newton_factorizations()) +
+                               " factorizations)";
+    if (cost_->newton_factorizations() == 0) {
+      s.preconditioner = PreconditionerName(*preconditioner_);
+    } else if (cost_->preconditioner_applications() == 0) {
+      s.preconditioner = newton;
+    } else {
+      s.preconditioner = PreconditionerName(*preconditioner_) + "; " + newton;
     }
     s.optimization_time_s += level.optimize_time_s;
     s.verification_time_s += level.verify_time_s;

@@ -194,6 +194,9 @@ class Staircase {
   bool ok_ = false;
   bool trivial_ = false;
   int d_ = 0, n_ = 0, r0_ = 0;
+  // The first level runs on the Newton system from its start (2D; see the
+  // constructor), which Initialize() builds while the set-up finishes.
+  bool newton_from_start_ = false;
   double scale_ = 0;           // max diag(D)
   double zero_objective_ = 0;  // F below this is zero up to round-off.
   std::unique_ptr<SESyncProblem> problem_;

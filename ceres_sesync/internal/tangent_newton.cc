@@ -55,48 +55,54 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
       }
     }
   };
-  // The vertex pairs (v >= w) of K_0's pattern and every diagonal pair, by
-  // w, then v: bucketed by w (a counting pass, then a fill), each bucket
-  // sorted and deduplicated.
+  // K_0's entries, each as (v, w) with v >= w (swapped where needed),
+  // bucketed by w: a counting pass, then a fill.
+  struct Entry {
+    int v, local;  // local: lw (1 + d) + lv in the pair's block.
+    double value;
+  };
   std::vector<int> bucket_start(vertices + 1, 0);
   for_each_entry_of_k0([&](int v, int, int w, int, double) {
     ++bucket_start[std::min(v, w) + 1];
   });
-  for (int v = 0; v < vertices; ++v) ++bucket_start[v + 1];
   for (int v = 0; v < vertices; ++v) bucket_start[v + 1] += bucket_start[v];
-  std::vector<int> bucket(bucket_start.back());
+  std::vector<Entry> entries(bucket_start.back());
   {
     std::vector<int> next(bucket_start.begin(), bucket_start.end() - 1);
-    for_each_entry_of_k0([&](int v, int, int w, int, double) {
-      bucket[next[std::min(v, w)]++] = std::max(v, w);
+    for_each_entry_of_k0([&](int v, int lv, int w, int lw, double value) {
+      if (v < w) {
+        std::swap(v, w);
+        std::swap(lv, lw);
+      }
+      entries[next[w]++] = {v, lw * b + lv, value};
     });
-    for (int v = 0; v < vertices; ++v) bucket[next[v]++] = v;
   }
+  // The vertex pairs (v >= w): by w, its diagonal pair first, then those of
+  // its entries in their order; K_0's (1 + d) x (1 + d) block of each
+  // (column-major) in base_. pair_of[v] is v's pair in the current w's
+  // bucket if it is at least that bucket's first pair.
+  std::vector<int> pair_of(vertices, -1);
   pair_start_.assign(vertices + 1, 0);
+  pair_first_.reserve(vertices + entries.size() / (b * b));
   for (int w = 0; w < vertices; ++w) {
-    const auto begin = bucket.begin() + bucket_start[w];
-    auto end = bucket.begin() + bucket_start[w + 1];
-    std::sort(begin, end);
-    end = std::unique(begin, end);
-    for (auto it = begin; it != end; ++it) {
-      pair_first_.push_back(*it);
-      pair_second_.push_back(w);
+    const int first_pair = pair_start_[w];
+    auto pair_index = [&](int v) {
+      if (pair_of[v] < first_pair) {
+        pair_of[v] = static_cast<int>(pair_first_.size());
+        pair_first_.push_back(v);
+        pair_second_.push_back(w);
+        base_.resize(base_.size() + b * b, 0.0);
+      }
+      return pair_of[v];
+    };
+    pair_index(w);
+    for (int q = bucket_start[w]; q < bucket_start[w + 1]; ++q) {
+      const Entry& e = entries[q];
+      base_[static_cast<size_t>(pair_index(e.v)) * b * b + e.local] = e.value;
     }
     pair_start_[w + 1] = static_cast<int>(pair_first_.size());
   }
   const size_t num_pairs = pair_first_.size();
-  // K_0's (1 + d) x (1 + d) block of each pair, column-major.
-  base_.assign(num_pairs * b * b, 0.0);
-  for_each_entry_of_k0([&](int v, int lv, int w, int lw, double value) {
-    if (v < w) {
-      std::swap(v, w);
-      std::swap(lv, lw);
-    }
-    const auto begin = pair_first_.begin() + pair_start_[w];
-    const auto end = pair_first_.begin() + pair_start_[w + 1];
-    const auto pair = std::lower_bound(begin, end, v) - pair_first_.begin();
-    base_[(pair * b + lw) * b + lv] = value;
-  });
   // The unknowns of each vertex, and the elimination order: the vertices'
   // (problem.vertex_ordering()), each vertex's unknowns together.
   unknown_start_.assign(vertices + 1, 0);
@@ -262,6 +268,23 @@ bool TangentNewton::Factorize(const Eigen::MatrixXd& Y,
   Y_ = Y;
   ++factorizations_;
   return true;
+}
+
+void TangentNewton::Rebase(const Eigen::MatrixXd& Y) {
+  const int D = d_, P = p_;
+  const double s = 1 / std::sqrt(2.0);
+  for (int blk = 0; blk < n_; ++blk) {
+    int k = 0;
+    for (int i = 0; i < D; ++i) {
+      for (int j = i + 1; j < D; ++j, ++k) {
+        auto W = rotated_.middleCols(D * (P * blk + k), D);
+        W.setZero();
+        W.col(i) = s * Y.col(D * blk + j);
+        W.col(j) = -s * Y.col(D * blk + i);
+      }
+    }
+  }
+  Y_ = Y;
 }
 
 void TangentNewton::Apply(const Eigen::MatrixXd& V, Eigen::MatrixXd* PV) const {

@@ -42,6 +42,11 @@ class TangentNewton {
   void Apply(const Eigen::MatrixXd& V, Eigen::MatrixXd* PV) const;
   // The point of the last successful Factorize().
   const Eigen::MatrixXd& point() const { return Y_; }
+  // Keeps the factor of the last successful Factorize() and moves the
+  // tangent basis that Apply() maps through to Y (blocks in O(d)): Apply()
+  // is then E(Y) H_old^{-1} E(Y)^T, symmetric positive definite on Y's
+  // tangent space, H_old's inverse carried to Y. point() becomes Y.
+  void Rebase(const Eigen::MatrixXd& Y);
   int factorizations() const { return factorizations_; }
 
  private:
