@@ -666,6 +666,20 @@ TEST(SESyncSolver, NewtonFromTheStartIn2D) {
               std::max(s_on.objective - s_on.lower_bound,
                        s_off.objective - s_off.lower_bound));
   }
+  // Where one factorization costs more than ~16 solves (a 10^4-pose city:
+  // ~21), block-Jacobi's cheap products stay the first level's.
+  CityOptions large;
+  large.num_poses = 10000;
+  large.seed = 1;
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(GenerateCity(large, &graph, nullptr, &error)) << error;
+  SolverOptions o;
+  o.num_threads = 1;
+  SolverSummary s;
+  Solve(graph, o, &s);
+  EXPECT_EQ(s.status, Status::kCertifiedOptimum) << s.FullReport();
+  EXPECT_EQ(s.preconditioner, "block-Jacobi");
 }
 
 // A 1000-pose city at kappa 10 (seed 1), which has a rank-4 saddle.

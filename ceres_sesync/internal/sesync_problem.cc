@@ -242,10 +242,17 @@ std::vector<Triplet> VertexPattern(const PoseGraph& graph,
 // for that analysis, 7.8 s for the second METIS).
 constexpr int kMinNestedDissectionVertices = 10000;
 
-std::vector<int> VertexOrdering(const PoseGraph& graph,
-                                const ProblemLayout& layout) {
+// The ordering, and CHOLMOD's flop count of the vertex pattern's factor
+// under it per nonzero of that factor.
+struct VertexOrderingResult {
+  std::vector<int> ordering;
+  double flops_per_entry = 0;
+};
+
+VertexOrderingResult VertexOrdering(const PoseGraph& graph,
+                                    const ProblemLayout& layout) {
   const int num_vertices = layout.num_vertices();
-  if (num_vertices == 1) return {0};
+  if (num_vertices == 1) return {{0}, 0};
   const std::vector<Triplet> vertex_pattern = VertexPattern(graph, layout);
   SparseMatrix pattern(num_vertices, num_vertices);
   pattern.setFromTriplets(vertex_pattern.begin(), vertex_pattern.end());
@@ -254,9 +261,10 @@ std::vector<int> VertexOrdering(const PoseGraph& graph,
   analysis.cholmod().nmethods = 1;
   analysis.cholmod().method[0].ordering = CHOLMOD_AMD;
   analysis.analyzePattern(pattern);
-  std::vector<int> ordering = analysis.Ordering();
+  VertexOrderingResult result{analysis.Ordering(), 0};
   const double block_flops = std::pow(graph.dimension + 1.0, 3) / 2;
   const double flops = analysis.cholmod().fl;
+  result.flops_per_entry = flops / std::max(1.0, analysis.cholmod().lnz);
   if (num_vertices >= kMinNestedDissectionVertices &&
       flops * block_flops > 2e4 * num_vertices) {
     CholmodFactor nested;
@@ -266,12 +274,14 @@ std::vector<int> VertexOrdering(const PoseGraph& graph,
     common.method[0].ordering = CHOLMOD_METIS;
     nested.analyzePattern(pattern);
     if (nested.info() == Eigen::Success && nested.cholmod().fl < flops) {
-      ordering = nested.Ordering();
+      result.ordering = nested.Ordering();
+      result.flops_per_entry =
+          common.fl / std::max(1.0, static_cast<double>(common.lnz));
     }
     VLOG(1) << "vertex ordering: AMD " << flops << " flops, METIS "
             << nested.cholmod().fl;
   }
-  return ordering;
+  return result;
 }
 
 }  // namespace
@@ -302,14 +312,18 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
   // each, the AMD and METIS analyses and the assembly; below ~5000 vertices
   // both take a few ms, not worth a thread).
   if (num_threads_ > 1 && layout.num_vertices() >= 5000) {
-    std::future<std::vector<int>> ordering =
+    std::future<VertexOrderingResult> ordering =
         std::async(std::launch::async,
                    [&graph, &layout] { return VertexOrdering(graph, layout); });
     Assemble();
-    vertex_ordering_ = ordering.get();
+    VertexOrderingResult result = ordering.get();
+    vertex_ordering_ = std::move(result.ordering);
+    vertex_flops_per_entry_ = result.flops_per_entry;
   } else {
     Assemble();
-    vertex_ordering_ = VertexOrdering(graph, layout);
+    VertexOrderingResult result = VertexOrdering(graph, layout);
+    vertex_ordering_ = std::move(result.ordering);
+    vertex_flops_per_entry_ = result.flops_per_entry;
   }
   if (layout.num_vertices() == 1) {
     ok_ = true;

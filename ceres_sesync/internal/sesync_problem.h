@@ -418,6 +418,11 @@ class SESyncProblem {
   // landmarks, the world) from the pattern of M collapsed to vertices:
   // ordering[k] = vertex eliminated k-th.
   const std::vector<int>& vertex_ordering() const { return vertex_ordering_; }
+  // The flop count of a Cholesky factorization of that collapsed pattern in
+  // this ordering per nonzero of its factor (CHOLMOD's symbolic analysis): a
+  // factorization's cost in solves of its factor, up to a constant, for any
+  // matrix with the vertices' pattern in blocks (K, the Newton system).
+  double vertex_flops_per_entry() const { return vertex_flops_per_entry_; }
   // A bound on the backward error of Lbar's Cholesky factorization
   // (CholmodFactor::BackwardErrorBound): the scale of the round-off that
   // factorizations of matrices containing Lbar make in its rows. O(nnz) per
@@ -463,6 +468,7 @@ class SESyncProblem {
   std::unique_ptr<CholmodFactor> lbar_factor_;
   SparseCholeskyFactor lbar_solver_;  // The same factor, for MultiplyQ.
   std::vector<int> vertex_ordering_;
+  double vertex_flops_per_entry_ = 0;
   // The background factorization of Lbar (declared last: destroyed, i.e.
   // joined, first).
   std::shared_future<void> lbar_pending_;

@@ -79,6 +79,26 @@ constexpr double kDenseFactorSolves = 3;
 // (city10000) times the ratio; cubicle's 38.
 constexpr double kBlockJacobiBudget = 20;
 
+// 2D: the Newton system from the start of the first level where its
+// factorization costs at most this many solves of its factor (estimate
+// below). Two threads, against the default before it: city10000 (10.5)
+// 1.5x faster; 2D cities of 10^4 poses (21) the same, of 10^5 (49) 0.7x
+// (one Newton factorization there costs more than block-Jacobi's ~120
+// products); every dataset below 5 faster (CSAIL 1.09x .. intel 1.49x).
+constexpr double kNewtonFromStartSolves = 16;
+
+// The 2D Newton system's (and K's) factorization cost in solves of its
+// factor with d rows, from the vertex pattern's analysis: blocks of b = d + 1
+// give b^3 times the flops and b^2 times the entries, a solve costs 4 d
+// multiply-adds per entry, CHOLMOD counts 2 flops per multiply-add: b / (4 d)
+// flops per entry (3/8 of it in 2D; K's measured cost at rank d: CSAIL 1.11
+// against 1.23 estimated, manhattan 4.37 / 4.34, city10000 10.50 / 10.37, a
+// 10^5-pose city 49.4 / 48.8).
+double NewtonCostInSolves(const SESyncProblem& problem) {
+  const int d = problem.dimension();
+  return (d + 1.0) / (4.0 * d) * problem.vertex_flops_per_entry();
+}
+
 struct PreconditionerChoice {
   PreconditionerType type;
   PreconditionerSettings settings;
@@ -281,11 +301,14 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
   // from the first solve, takes 2-4 products per rank-d solve (kitti_00 22
   // -> 4, intel 23 -> 3, city10000 100 -> 4) with a factorization or two:
   // faster than (Q + eps I)^-1, whose factorization is then skipped unless
-  // a higher rank needs it. In 3D H has 3.4x K's flops, and the switch rule
-  // below decides. (A random start is not at rank d.)
+  // a higher rank needs it, and than block-Jacobi's many cheap products
+  // while its factorization costs at most kNewtonFromStartSolves solves. In
+  // 3D H has 3.4x K's flops, and the switch rule below decides. (A random
+  // start is not at rank d.)
   newton_from_start_ =
       options.newton_at_rank_d && d_ == 2 &&
-      options.initialization != SolverOptions::Initialization::kRandom;
+      options.initialization != SolverOptions::Initialization::kRandom &&
+      NewtonCostInSolves(*problem_) <= kNewtonFromStartSolves;
   auto prepare = [this] {
     if (!problem_->ok()) return;  // Initialize() reports it.
     certificate_ = std::make_unique<CertificateMatrix>(*problem_);
@@ -321,7 +344,8 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
                           /*exact_fallback=*/choice.exact &&
                               choice.type == PreconditionerType::kAdaptive);
       VLOG(1) << "Newton at rank d: factorization cost " << cost
-              << " solves, K's " << k_cost;
+              << " solves, K's " << k_cost << ", vertex flops per entry "
+              << problem_->vertex_flops_per_entry();
     }
   };
   if (parallel_window) {
