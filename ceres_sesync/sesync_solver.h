@@ -106,13 +106,18 @@ struct SolverOptions {
   // tangent vectors are Y_i Omega_i with Omega_i skew, and the Riemannian
   // Hessian is a sparse matrix in the coordinates of the Omega_i and the
   // translations (a Gauss-Newton-sized system of SE(d)^n, but the exact
-  // Hessian). With this option the first level switches to that matrix's
-  // inverse as the preconditioner (refactorized at every iterate; where it
-  // is not positive definite the preconditioner above is used) when one of
-  // its first two truncated-CG solves takes more than about twice its
-  // factorization's cost in products. Each later subproblem then takes one
-  // or two products: ais2klinik 463 -> 18 products (4.6x faster),
-  // parking-garage 205 -> 56 (1.7x); the other datasets do not switch.
+  // Hessian). With this option that matrix's inverse preconditions the
+  // first level's truncated CG (where it is not positive definite the
+  // preconditioner above is used), each subproblem then taking one or two
+  // products. In 2D, where its factorization costs at most 16 solves of its
+  // factor (every shared 2D dataset; cities to ~10^4 poses), from the level's
+  // start, its factor kept while the subproblems stay short, and kAutomatic's
+  // exact preconditioner then factorized only if used: kitti_00 22 -> 4
+  // products (1.28x faster), intel 23 -> 3 (1.30x), city10000 100 -> 4
+  // (1.34x). Elsewhere the level switches to it (refactorized at every
+  // iterate) when one of its first two truncated-CG solves takes more than
+  // about twice its factorization's cost in products: parking-garage 205 ->
+  // 56 (1.7x); the other 3D datasets do not switch.
   bool newton_at_rank_d = true;
 
   enum class LocalSolver {
@@ -336,9 +341,10 @@ struct SolverSummary {
   // The truncated-CG preconditioner the solve ended with (kAutomatic
   // resolved): "none", "block-Jacobi", "sparse Cholesky of D" or "exact
   // (Q + eps I)^-1"; when kAutomatic's block-Jacobi switched, "exact (Q +
-  // eps I)^-1 after N block-Jacobi iterations". When the first level
-  // switched to the Newton preconditioner (newton_at_rank_d), followed by
-  // "; Newton at rank d (N factorizations)".
+  // eps I)^-1 after N block-Jacobi iterations". When the first level used
+  // the Newton preconditioner (newton_at_rank_d), followed by "; Newton at
+  // rank d (N factorizations)", or that alone when the preconditioner above
+  // was never applied.
   std::string preconditioner;
   // Cholesky factorizations of the certificate matrix in verification
   // (certificate tests included), in double and in double-double, and the

@@ -277,7 +277,9 @@ TEST(RobustSolver, GncStepsStopAtGncMaxRankWithoutTheTopCertificateTest) {
 // gnc_relative_decrease_tolerance (its default) ends the GNC steps' local
 // searches earlier than the caller's 1e-12 and touches nothing after GNC:
 // the verdicts and the certified inlier optimum are those of the tight
-// steps.
+// steps. (With the Newton preconditioner at rank d, the 2D default, the
+// tight steps take 1-5 iterations each on this chain and the loose ones lead
+// GNC through more steps, 15 -> 28, so the comparison is made without it.)
 TEST(RobustSolver, GncStepsStopAtTheirRelativeDecreaseTolerance) {
   for (int d : {2, 3}) {
     PoseGraph corrupted;
@@ -291,6 +293,7 @@ TEST(RobustSolver, GncStepsStopAtTheirRelativeDecreaseTolerance) {
       return iterations;
     };
     RobustSolverOptions options = Options();
+    options.solver_options.newton_at_rank_d = false;
     options.gnc_relative_decrease_tolerance = 0;  // The caller's 1e-12.
     RobustSolverSummary tight;
     SolveRobust(corrupted, options, &tight);

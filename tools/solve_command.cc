@@ -46,9 +46,10 @@ DEFINE_bool(test_certificate_near_convergence,
             "small, and stop it if the verification's first proof holds "
             "(SolverOptions::test_certificate_near_convergence).");
 DEFINE_bool(newton_at_rank_d, ceres_sesync::SolverOptions().newton_at_rank_d,
-            "Let the first level switch to the Riemannian Hessian's inverse "
-            "as the truncated-CG preconditioner when its first solves are "
-            "long (SolverOptions::newton_at_rank_d).");
+            "Precondition the first level's truncated CG with the "
+            "Riemannian Hessian's inverse: in 2D from the start where it is "
+            "cheap, else once its first solves are long "
+            "(SolverOptions::newton_at_rank_d).");
 DEFINE_bool(components, false,
             "Solve a disconnected graph per connected component, each in its "
             "own gauge (its first pose, or its FIX pose, fixed); the report "

@@ -198,6 +198,9 @@ class SESyncCost : public RiemannianCostFunction {
   bool newton_from_start_ = false, newton_exact_fallback_ = false;
   bool newton_allowed_ = false, newton_active_ = false;
   int solves_ = 0;  // Truncated-CG solves since BeginSolve().
+  // Failed factorizations since BeginSolve() (used from the start), and the
+  // truncated-CG solves left before the next try (Precondition()).
+  int newton_failures_ = 0, newton_skip_solves_ = 0;
   // Products of the last truncated-CG solve (of this or an earlier solve).
   int last_solve_products_ = std::numeric_limits<int>::max();
   double newton_eps_ = 0;
