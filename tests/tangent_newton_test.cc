@@ -75,22 +75,25 @@ void ExpectInverseOfTheHessian(const PoseGraph& graph, uint64_t seed) {
   EXPECT_EQ(newton.point(), Y);
   const MatrixXd reference_inverse =
       (M + eps * MatrixXd::Identity(m, m)).inverse();
-  for (int trial = 0; trial < 3; ++trial) {
+  // Apply(V) for a random V = sum_i g_i B_i against sum_i z_i B_i, z =
+  // reference_inverse g, B_i the basis at newton.point().
+  std::normal_distribution<double> normal;
+  auto expect_inverse = [&](const std::vector<MatrixXd>& B, int trial) {
     MatrixXd V = MatrixXd::Zero(d, d * n);
     Eigen::VectorXd g(m);
-    std::normal_distribution<double> normal;
     for (int i = 0; i < m; ++i) {
       g(i) = normal(rng);
-      V += g(i) * basis[i];
+      V += g(i) * B[i];
     }
     const Eigen::VectorXd z = reference_inverse * g;
     MatrixXd expected = MatrixXd::Zero(d, d * n);
-    for (int i = 0; i < m; ++i) expected += z(i) * basis[i];
+    for (int i = 0; i < m; ++i) expected += z(i) * B[i];
     MatrixXd PV;
     newton.Apply(V, &PV);
     EXPECT_LT((PV - expected).norm(), 1e-10 * expected.norm())
         << "d = " << d << ", trial " << trial;
-  }
+  };
+  for (int trial = 0; trial < 3; ++trial) expect_inverse(basis, trial);
   // Rebase() carries the factor of Y to another point Y1: Apply(V) = sum_i
   // z_i B_i(Y1) with z = (M + eps I)^{-1} (<B_i(Y1), V>)_i, M still Y's.
   MatrixXd Y1(d, d * n);
@@ -99,20 +102,7 @@ void ExpectInverseOfTheHessian(const PoseGraph& graph, uint64_t seed) {
   }
   newton.Rebase(Y1);
   EXPECT_EQ(newton.point(), Y1);
-  const std::vector<MatrixXd> basis1 = TangentBasis(Y1, d);
-  MatrixXd V = MatrixXd::Zero(d, d * n);
-  Eigen::VectorXd g(m);
-  std::normal_distribution<double> normal;
-  for (int i = 0; i < m; ++i) {
-    g(i) = normal(rng);
-    V += g(i) * basis1[i];
-  }
-  const Eigen::VectorXd z = reference_inverse * g;
-  MatrixXd expected = MatrixXd::Zero(d, d * n);
-  for (int i = 0; i < m; ++i) expected += z(i) * basis1[i];
-  MatrixXd PV;
-  newton.Apply(V, &PV);
-  EXPECT_LT((PV - expected).norm(), 1e-10 * expected.norm()) << "d = " << d;
+  expect_inverse(TangentBasis(Y1, d), /*trial=*/3);
 }
 
 TEST(TangentNewton, ApplyIsTheInverseOfTheRiemannianHessian) {
@@ -144,67 +134,83 @@ TEST(TangentNewton, ApplyIsTheInverseWithLandmarksAndPriors) {
   }
 }
 
-// A rank-d descent from the chordal start with the switch forced at the
-// first truncated-CG solve (EnableNewton(0)) against the same descent
-// without it: the same minimum (the gradient at both end points below the
-// tolerance), in fewer products, the Newton system refactorized at each
-// iterate; the switch does not carry into a solve begun without it. (The
-// minimum is nondegenerate up to the gauge, so both end points are within
-// about |grad| / lambda_min(Hess) of it.)
+// A rank-d descent from the chordal start of a 300-pose chain (30 loop
+// closures, kappa 30, tau 5) preconditioned by (Q + eps I)^-1 with the
+// Newton system as EnableNewton(switch_products, from_start) sets it, to an
+// absolute gradient tolerance of 1e-6 (with F ~ 100: reachable above the
+// round-off of F's differences, where the trust region stops accepting
+// steps).
+struct Descent {
+  MatrixXd minimum;
+  RiemannianTrustRegionSummary summary;
+  bool newton_active = false;
+  bool newton_active_in_a_plain_solve = false;  // After BeginSolve(false).
+  int newton_factorizations = 0, preconditioner_applications = 0;
+};
+
+Descent Descend(int d, uint64_t seed, int switch_products, bool from_start) {
+  test_util::RandomGraphOptions o;
+  o.dimension = d;
+  o.num_poses = 300;
+  o.num_loop_closures = 30;
+  o.chain = true;
+  o.kappa = 30;
+  o.tau = 5;
+  o.seed = seed;
+  const PoseGraph graph = test_util::RandomPoseGraph(o, nullptr);
+  const SESyncProblem problem(graph);
+  EXPECT_TRUE(problem.ok());
+  Descent descent;
+  EXPECT_TRUE(ChordalRotations(problem, &descent.minimum));
+  SESyncPreconditioner exact(problem, PreconditionerType::kRegularizedQ, 1e6);
+  RiemannianTrustRegionOptions rtr;
+  rtr.gradient_tolerance = 1e-6;
+  rtr.relative_decrease_tolerance = 0;
+  rtr.preconditioned_gradient_tolerance = 0;
+  rtr.step_tolerance = 0;
+  SESyncCost cost(&problem, &exact);
+  cost.EnableNewton(switch_products, from_start);
+  cost.BeginSolve(/*allow_newton=*/true);
+  MinimizeRiemannianTrustRegion(rtr, &cost, &descent.minimum, &descent.summary);
+  EXPECT_EQ(descent.summary.termination,
+            RiemannianTrustRegionSummary::Termination::kGradientTolerance)
+      << "d = " << d << ", switch at " << switch_products
+      << (from_start ? ", from the start" : "");
+  descent.newton_active = cost.newton_active();
+  descent.newton_factorizations = cost.newton_factorizations();
+  descent.preconditioner_applications = cost.preconditioner_applications();
+  cost.BeginSolve(/*allow_newton=*/false);
+  descent.newton_active_in_a_plain_solve = cost.newton_active();
+  return descent;
+}
+
+// The same minimum up to the gauge (R_0 is not fixed): R_0^T R_i within
+// 1e-6. (The minimum is nondegenerate up to the gauge, so both end points
+// are within about |grad| / lambda_min(Hess) of it.)
+void ExpectTheSameMinimum(const MatrixXd& A, const MatrixXd& B, int d) {
+  auto relative = [d](const MatrixXd& Y) {
+    return MatrixXd(Y.leftCols(d).transpose() * Y);
+  };
+  EXPECT_LT((relative(A) - relative(B)).cwiseAbs().maxCoeff(), 1e-6)
+      << "d = " << d;
+}
+
+// A descent with the switch forced at the first truncated-CG solve
+// (EnableNewton(0)) against the same descent without it: the same minimum
+// in fewer products, the Newton system refactorized at each iterate; the
+// switch does not carry into a solve begun without it.
 TEST(TangentNewton, SwitchedDescentReachesTheSameMinimum) {
   for (int d : {2, 3}) {
-    test_util::RandomGraphOptions o;
-    o.dimension = d;
-    o.num_poses = 300;
-    o.num_loop_closures = 30;
-    o.chain = true;
-    o.kappa = 30;
-    o.tau = 5;
-    o.seed = 11 + d;
-    const PoseGraph graph = test_util::RandomPoseGraph(o, nullptr);
-    const SESyncProblem problem(graph);
-    ASSERT_TRUE(problem.ok());
-    MatrixXd start;
-    ASSERT_TRUE(ChordalRotations(problem, &start));
-    SESyncPreconditioner exact(problem, PreconditionerType::kRegularizedQ, 1e6);
-    RiemannianTrustRegionOptions rtr;
-    // Absolute, with F ~ 100: reachable above the round-off of F's
-    // differences, where the trust region stops accepting steps.
-    rtr.gradient_tolerance = 1e-6;
-    rtr.relative_decrease_tolerance = 0;
-    rtr.preconditioned_gradient_tolerance = 0;
-    rtr.step_tolerance = 0;
-    std::vector<MatrixXd> minima;
-    std::vector<int> products;
-    for (const bool newton : {false, true}) {
-      SESyncCost cost(&problem, &exact);
-      cost.EnableNewton(newton ? 0 : -1);
-      cost.BeginSolve(/*allow_newton=*/true);
-      MatrixXd Y = start;
-      RiemannianTrustRegionSummary summary;
-
-      MinimizeRiemannianTrustRegion(rtr, &cost, &Y, &summary);
-      EXPECT_EQ(summary.termination,
-                RiemannianTrustRegionSummary::Termination::kGradientTolerance)
-          << "d = " << d << (newton ? " with" : " without") << " Newton";
-      EXPECT_EQ(cost.newton_active(), newton);
-      minima.push_back(Y);
-      products.push_back(summary.hessian_vector_products);
-      if (newton) {
-        EXPECT_GT(cost.newton_factorizations(), 1);
-        cost.BeginSolve(/*allow_newton=*/false);
-        EXPECT_FALSE(cost.newton_active());
-      }
-    }
-    EXPECT_LT(products[1], products[0]) << "d = " << d;
-    // The same minimum up to the gauge (R_0 is not fixed): compare
-    // R_0^T R_i.
-    auto relative = [d](const MatrixXd& Y) {
-      return MatrixXd(Y.leftCols(d).transpose() * Y);
-    };
-    EXPECT_LT((relative(minima[1]) - relative(minima[0])).cwiseAbs().maxCoeff(),
-              1e-6)
+    const Descent plain = Descend(d, 11 + d, -1, false);
+    const Descent newton = Descend(d, 11 + d, 0, false);
+    EXPECT_FALSE(plain.newton_active);
+    EXPECT_TRUE(newton.newton_active);
+    EXPECT_GT(newton.newton_factorizations, 1);
+    EXPECT_FALSE(newton.newton_active_in_a_plain_solve);
+    EXPECT_LT(newton.summary.hessian_vector_products,
+              plain.summary.hessian_vector_products)
         << "d = " << d;
+    ExpectTheSameMinimum(newton.minimum, plain.minimum, d);
   }
 }
 
@@ -214,52 +220,15 @@ TEST(TangentNewton, SwitchedDescentReachesTheSameMinimum) {
 // the factor kept across iterates while the solves stay short (fewer
 // factorizations than iterations).
 TEST(TangentNewton, DescentFromTheStartKeepsItsFactor) {
-  test_util::RandomGraphOptions o;
-  o.dimension = 2;
-  o.num_poses = 300;
-  o.num_loop_closures = 30;
-  o.chain = true;
-  o.kappa = 30;
-  o.tau = 5;
-  o.seed = 21;
-  const PoseGraph graph = test_util::RandomPoseGraph(o, nullptr);
-  const SESyncProblem problem(graph);
-  ASSERT_TRUE(problem.ok());
-  MatrixXd start;
-  ASSERT_TRUE(ChordalRotations(problem, &start));
-  SESyncPreconditioner exact(problem, PreconditionerType::kRegularizedQ, 1e6);
-  RiemannianTrustRegionOptions rtr;
-  rtr.gradient_tolerance = 1e-6;  // As above.
-  rtr.relative_decrease_tolerance = 0;
-  rtr.preconditioned_gradient_tolerance = 0;
-  rtr.step_tolerance = 0;
-  std::vector<MatrixXd> minima;
-  std::vector<int> products;
-  for (const bool newton : {false, true}) {
-    SESyncCost cost(&problem, &exact);
-    cost.EnableNewton(-1, /*from_start=*/newton);
-    cost.BeginSolve(/*allow_newton=*/true);
-    EXPECT_EQ(cost.newton_active(), newton);
-    MatrixXd Y = start;
-    RiemannianTrustRegionSummary summary;
-    MinimizeRiemannianTrustRegion(rtr, &cost, &Y, &summary);
-    EXPECT_EQ(summary.termination,
-              RiemannianTrustRegionSummary::Termination::kGradientTolerance)
-        << (newton ? "with" : "without") << " Newton";
-    minima.push_back(Y);
-    products.push_back(summary.hessian_vector_products);
-    if (newton) {
-      EXPECT_EQ(cost.preconditioner_applications(), 0);
-      EXPECT_GE(cost.newton_factorizations(), 1);
-      EXPECT_LT(cost.newton_factorizations(), summary.iterations);
-    }
-  }
-  EXPECT_LT(products[1], products[0]);
-  auto relative = [](const MatrixXd& Y) {
-    return MatrixXd(Y.leftCols(2).transpose() * Y);
-  };
-  EXPECT_LT((relative(minima[1]) - relative(minima[0])).cwiseAbs().maxCoeff(),
-            1e-6);
+  const Descent plain = Descend(2, 21, -1, false);
+  const Descent newton = Descend(2, 21, -1, true);
+  EXPECT_TRUE(newton.newton_active);
+  EXPECT_EQ(newton.preconditioner_applications, 0);
+  EXPECT_GE(newton.newton_factorizations, 1);
+  EXPECT_LT(newton.newton_factorizations, newton.summary.iterations);
+  EXPECT_LT(newton.summary.hessian_vector_products,
+            plain.summary.hessian_vector_products);
+  ExpectTheSameMinimum(newton.minimum, plain.minimum, 2);
 }
 
 }  // namespace

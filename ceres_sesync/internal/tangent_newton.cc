@@ -182,25 +182,11 @@ void TangentNewton::Assemble(const Eigen::MatrixXd& Y,
   // vector's entries at the vertex's K_0 rows (0: translation, 1 + c:
   // rotation column c) as functions of its unknowns (0 .. D-1: translation
   // coordinates, D + k: rotation coordinate k), zero where the vertex has
-  // no such unknown. Y_i E_k for the orthonormal skew basis E_k (E_k(j, i) =
-  // -E_k(i, j) = 1 / sqrt(2), i < j): its column i is Y_i's column j /
-  // sqrt(2), its column j minus Y_i's column i / sqrt(2).
-  const double s = 1 / std::sqrt(2.0);
-  rotated_.resize(D, D * P * n_);
+  // no such unknown, from the tangent basis Y_i E_k (SetBasis).
+  SetBasis(Y);
   embedding_.assign(static_cast<size_t>(vertices) * D * B * U, 0.0);
   for (int v = 0; v < vertices; ++v) {
     const int blk = rotation_of_vertex_[v];
-    if (blk >= 0) {
-      int k = 0;
-      for (int i = 0; i < D; ++i) {
-        for (int j = i + 1; j < D; ++j, ++k) {
-          auto W = rotated_.middleCols(D * (P * blk + k), D);
-          W.setZero();
-          W.col(i) = s * Y.col(D * blk + j);
-          W.col(j) = -s * Y.col(D * blk + i);
-        }
-      }
-    }
     for (int a = 0; a < D; ++a) {
       Eigen::Map<MatE> E(embedding_.data() +
                          (static_cast<size_t>(v) * D + a) * B * U);
@@ -270,9 +256,13 @@ bool TangentNewton::Factorize(const Eigen::MatrixXd& Y,
   return true;
 }
 
-void TangentNewton::Rebase(const Eigen::MatrixXd& Y) {
+void TangentNewton::SetBasis(const Eigen::MatrixXd& Y) {
+  // Y_i E_k for the orthonormal skew basis E_k (E_k(j, i) = -E_k(i, j) =
+  // 1 / sqrt(2), i < j): its column i is Y_i's column j / sqrt(2), its
+  // column j minus Y_i's column i / sqrt(2).
   const int D = d_, P = p_;
   const double s = 1 / std::sqrt(2.0);
+  rotated_.resize(D, D * P * n_);
   for (int blk = 0; blk < n_; ++blk) {
     int k = 0;
     for (int i = 0; i < D; ++i) {
@@ -284,6 +274,10 @@ void TangentNewton::Rebase(const Eigen::MatrixXd& Y) {
       }
     }
   }
+}
+
+void TangentNewton::Rebase(const Eigen::MatrixXd& Y) {
+  SetBasis(Y);
   Y_ = Y;
 }
 

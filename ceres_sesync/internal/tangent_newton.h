@@ -50,6 +50,8 @@ class TangentNewton {
   int factorizations() const { return factorizations_; }
 
  private:
+  // rotated_: the tangent basis Y_i E_k at Y.
+  void SetBasis(const Eigen::MatrixXd& Y);
   // Fills values_ with H + eps (the rotation unknowns' diagonal) at Y, in
   // the order of slot_; also sets rotated_.
   template <int D>
