@@ -279,7 +279,9 @@ TEST(RobustSolver, GncStepsStopAtGncMaxRankWithoutTheTopCertificateTest) {
 // the verdicts and the certified inlier optimum are those of the tight
 // steps. (With the Newton preconditioner at rank d, the 2D default, the
 // tight steps take 1-5 iterations each on this chain and the loose ones lead
-// GNC through more steps, 15 -> 28, so the comparison is made without it.)
+// GNC through more steps, 15 -> 28, so the comparison is made without it;
+// on intel + 10-50% outliers the default still saves a third of the time
+// with it.)
 TEST(RobustSolver, GncStepsStopAtTheirRelativeDecreaseTolerance) {
   for (int d : {2, 3}) {
     PoseGraph corrupted;
