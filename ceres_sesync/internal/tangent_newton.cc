@@ -83,7 +83,12 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
   // bucket if it is at least that bucket's first pair.
   std::vector<int> pair_of(vertices, -1);
   pair_start_.assign(vertices + 1, 0);
-  pair_first_.reserve(vertices + entries.size() / (b * b));
+  // About the number of pairs (a full block has b^2 entries, and each
+  // vertex's diagonal block is counted besides).
+  const size_t expected_pairs = vertices + entries.size() / (b * b);
+  pair_first_.reserve(expected_pairs);
+  pair_second_.reserve(expected_pairs);
+  base_.reserve(expected_pairs * b * b);
   for (int w = 0; w < vertices; ++w) {
     const int first_pair = pair_start_[w];
     auto pair_index = [&](int v) {
