@@ -82,9 +82,10 @@ constexpr double kBlockJacobiBudget = 20;
 // 2D: the Newton system from the start of the first level where its
 // factorization costs at most this many solves of its factor (estimate
 // below). Two threads, against the default before it: city10000 (10.5)
-// 1.5x faster; 2D cities of 10^4 poses (21) the same, of 10^5 (49) 0.7x
+// 1.6x faster; 2D cities of 10^4 poses (21) the same, of 10^5 (49) 0.7x
 // (one Newton factorization there costs more than block-Jacobi's ~120
-// products); every dataset below 5 faster (CSAIL 1.09x .. intel 1.49x).
+// products); the other 2D datasets (1.0-4.4) 1.08x (CSAIL) to 1.46x
+// (intel) faster, on one thread 0.95x (CSAIL) to 1.31x (intel).
 constexpr double kNewtonFromStartSolves = 16;
 
 // The 2D Newton system's (and K's) factorization cost in solves of its
