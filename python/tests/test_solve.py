@@ -79,6 +79,12 @@ def test_options_by_keyword():
     assert auto.certified and auto.preconditioner == "block-Jacobi"
     assert exact.certified and exact.preconditioner == "exact (Q + eps I)^-1"
     assert abs(auto.objective - exact.objective) <= 1e-9 * exact.objective
+    # By default a 2D city this size runs its first level on the Newton
+    # system from the start (SolverOptions.newton_at_rank_d), nothing else.
+    newton = cs.solve(city)
+    assert newton.certified and newton.preconditioner.startswith("Newton at rank d (")
+    assert newton.hessian_vector_products < auto.hessian_vector_products
+    assert abs(newton.objective - auto.objective) <= 1e-9 * auto.objective
     double = cs.solve(g, proof_arithmetic="double")
     assert double.certified and double.proof_precision == "double"
     assert double.extended_factorizations == 0
