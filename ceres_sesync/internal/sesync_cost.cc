@@ -195,8 +195,13 @@ void SESyncCost::EnableNewton(int switch_products, bool from_start,
 }
 
 void SESyncCost::ProvideNewton(std::unique_ptr<TangentNewton> newton) {
-  if (!newton_from_start_ || newton_ != nullptr) return;
-  newton_ = std::move(newton);
+  if (newton_from_start_) BuildNewton(std::move(newton));
+}
+
+void SESyncCost::BuildNewton(std::unique_ptr<TangentNewton> built) {
+  if (newton_ != nullptr) return;
+  newton_ =
+      built ? std::move(built) : std::make_unique<TangentNewton>(*problem_);
   newton_eps_ = NewtonShift(problem_->D());
 }
 
@@ -206,10 +211,7 @@ void SESyncCost::BeginSolve(bool allow_newton) {
   solves_ = 0;
   newton_failures_ = newton_skip_solves_ = 0;
   if (newton_from_start_) {
-    if (newton_ == nullptr) {
-      newton_ = std::make_unique<TangentNewton>(*problem_);
-      newton_eps_ = NewtonShift(problem_->D());
-    }
+    BuildNewton();
     newton_active_ = true;
   }
 }
@@ -309,10 +311,7 @@ bool SESyncCost::UpdatePreconditioner(int inner_iterations, bool converged) {
   if (!newton_active_ && newton_allowed_ && newton_switch_products_ >= 0 &&
       Y_.rows() == d_ && !converged && solves_ <= kNewtonSwitchSolves &&
       inner_iterations > newton_switch_products_) {
-    if (newton_ == nullptr) {
-      newton_ = std::make_unique<TangentNewton>(*problem_);
-      newton_eps_ = NewtonShift(problem_->D());
-    }
+    BuildNewton();
     newton_active_ = true;
     return true;
   }

@@ -177,6 +177,10 @@ class SESyncCost : public RiemannianCostFunction {
   }
 
  private:
+  // Sets newton_ (`built`, else a new TangentNewton: its symbolic
+  // analysis) and its shift, unless it is set.
+  void BuildNewton(std::unique_ptr<TangentNewton> built = nullptr);
+
   const SESyncProblem* problem_;
   SESyncPreconditioner* preconditioner_;
   int d_;

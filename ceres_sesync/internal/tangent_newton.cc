@@ -82,7 +82,6 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
   // (column-major) in base_. pair_of[v] is v's pair in the current w's
   // bucket if it is at least that bucket's first pair.
   std::vector<int> pair_of(vertices, -1);
-  pair_start_.assign(vertices + 1, 0);
   // About the number of pairs (a full block has b^2 entries, and each
   // vertex's diagonal block is counted besides).
   const size_t expected_pairs = vertices + entries.size() / (b * b);
@@ -90,7 +89,7 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
   pair_second_.reserve(expected_pairs);
   base_.reserve(expected_pairs * b * b);
   for (int w = 0; w < vertices; ++w) {
-    const int first_pair = pair_start_[w];
+    const int first_pair = static_cast<int>(pair_first_.size());
     auto pair_index = [&](int v) {
       if (pair_of[v] < first_pair) {
         pair_of[v] = static_cast<int>(pair_first_.size());
@@ -105,7 +104,6 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
       const Entry& e = entries[q];
       base_[static_cast<size_t>(pair_index(e.v)) * b * b + e.local] = e.value;
     }
-    pair_start_[w + 1] = static_cast<int>(pair_first_.size());
   }
   const size_t num_pairs = pair_first_.size();
   // The unknowns of each vertex, and the elimination order: the vertices'

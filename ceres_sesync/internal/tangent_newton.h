@@ -65,9 +65,9 @@ class TangentNewton {
   // and its unknowns unknowns_[unknown_start_[v] ..].
   std::vector<int> translation_of_vertex_, rotation_of_vertex_;
   std::vector<int> unknown_start_, unknowns_;
-  // The vertex pairs (v >= w) of the pattern, by w (pair_start_), and K_0's
-  // (1 + d) x (1 + d) block of each without Lambda (column-major).
-  std::vector<int> pair_first_, pair_second_, pair_start_;
+  // The vertex pairs (v >= w) of the pattern, by w, and K_0's (1 + d) x
+  // (1 + d) block of each without Lambda (column-major).
+  std::vector<int> pair_first_, pair_second_;
   std::vector<double> base_;
   std::vector<int> ordering_;  // Unknowns in elimination order.
   std::vector<int> slot_;      // Where each computed entry goes.
