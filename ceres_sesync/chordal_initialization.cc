@@ -206,11 +206,17 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
   for (int k : block_order) {
     for (int a = 0; a < d; ++a) ordering.push_back(d * k + a);
   }
+  // With the vertices' ordering, each free block's d unknowns are pivots
+  // together: the pattern, completed to whole d x d blocks (the diagonal
+  // blocks' off-diagonal zeros), is analyzed by blocks.
+  std::vector<int> block_start;
   if (ordering.empty()) {  // No ordering, or not of every free block.
     CholmodFactor analysis;
     ConfigureCholmod(CholmodLayout::kSimplicial, &analysis);
     analysis.analyzePattern(L_ff);
     ordering = analysis.Ordering();
+  } else {
+    for (int k = 0; k <= num_free; ++k) block_start.push_back(d * k);
   }
   // The project's supernodal Cholesky (extended_cholesky.h, in double) with
   // the solves of sparse_cholesky_factor.h, not CHOLMOD: on sphere2500 and
@@ -219,8 +225,13 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
   // range the factorization accepts for any precisions.
   std::vector<int> position(size);
   for (int k = 0; k < size; ++k) position[ordering[k]] = k;
-  PermutedPattern pattern = PermuteSymmetricPattern(
-      size, L_ff.outerIndexPtr(), L_ff.innerIndexPtr(), position);
+  PermutedPattern pattern =
+      block_start.empty()
+          ? PermuteSymmetricPattern(size, L_ff.outerIndexPtr(),
+                                    L_ff.innerIndexPtr(), position)
+          : PermuteSymmetricBlockPattern(size, L_ff.outerIndexPtr(),
+                                         L_ff.innerIndexPtr(), position,
+                                         block_start);
   int exponent = 0;
   std::frexp(L_ff.coeffs().cwiseAbs().maxCoeff(), &exponent);
   std::vector<double> values(pattern.row_index.size());
@@ -233,7 +244,7 @@ bool ChordalRotationsFromLaplacian(const SparseMatrix& L, int d,
   options.num_threads = num_threads;
   DoubleDoubleCholesky factor(options);
   factor.Analyze(size, std::move(pattern.column_start),
-                 std::move(pattern.row_index));
+                 std::move(pattern.row_index), block_start);
   if (!factor.Factorize(values)) return false;
   const SparseCholeskyFactor solver(
       std::move(ordering),

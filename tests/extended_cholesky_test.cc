@@ -615,5 +615,157 @@ TEST(ExtendedCholesky, PermuteSymmetricPatternMatchesDensePermutation) {
   }
 }
 
+// Matrices of blocks (sizes 1-4; some entries inside blocks structurally
+// zero, so the pattern is not block-full) in a random block order:
+// PermuteSymmetricBlockPattern puts every entry of P A P^T in place and
+// completes the pattern to exactly the block pairs that hold an entry
+// (rows ascending), and Analyze() by those blocks equals the scalar
+// analysis of that pattern: the same counts, flops, supernodes and tree
+// split, the factors in double and double-double bitwise the same, with the
+// same backward-error bounds. The incomplete pattern is refused.
+TEST(ExtendedCholesky, BlockAnalysisEqualsScalarAnalysis) {
+  std::mt19937 rng(11);
+  int refused = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const int num_blocks = 1 + static_cast<int>(rng() % 60);
+    std::vector<int> size(num_blocks), first(num_blocks + 1, 0);
+    for (int b = 0; b < num_blocks; ++b) {
+      size[b] = 1 + static_cast<int>(rng() % 4);
+      first[b + 1] = first[b] + size[b];
+    }
+    const int n = first[num_blocks];
+    std::vector<int> block_of(n);
+    for (int b = 0; b < num_blocks; ++b) {
+      for (int i = first[b]; i < first[b + 1]; ++i) block_of[i] = b;
+    }
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    std::vector<std::vector<double>> dense(n, std::vector<double>(n, 0.0));
+    auto fill_pair = [&](int r, int c, double density) {
+      for (int i = first[r]; i < first[r + 1]; ++i) {
+        for (int j = first[c]; j < first[c + 1]; ++j) {
+          if (i != j && (r != c || i > j) && uniform(rng) < 2 * density - 1) {
+            dense[i][j] = dense[j][i] = uniform(rng);
+          }
+        }
+      }
+    };
+    for (int b = 0; b < num_blocks; ++b) {
+      fill_pair(b, b, 0.5);
+      if (b > 0) fill_pair(b, b - 1 - static_cast<int>(rng() % b), 0.7);
+      if (b > 1 && rng() % 2 == 0) {
+        fill_pair(b, static_cast<int>(rng() % b), 0.7);
+      }
+    }
+    for (int i = 0; i < n; ++i) {  // Diagonally dominant: SPD.
+      double sum = 1;
+      for (int j = 0; j < n; ++j) sum += std::abs(dense[i][j]);
+      dense[i][i] = sum;
+    }
+    std::vector<int> outer(1, 0), inner;
+    std::vector<double> value;
+    for (int c = 0; c < n; ++c) {
+      for (int r = 0; r < n; ++r) {
+        if (dense[r][c] != 0) {
+          inner.push_back(r);
+          value.push_back(dense[r][c]);
+        }
+      }
+      outer.push_back(static_cast<int>(inner.size()));
+    }
+    // Blocks in a random order, each block's unknowns together.
+    std::vector<int> block_order(num_blocks);
+    for (int b = 0; b < num_blocks; ++b) block_order[b] = b;
+    std::shuffle(block_order.begin(), block_order.end(), rng);
+    std::vector<int> ordering, block_start(1, 0);
+    for (int b : block_order) {
+      for (int i = first[b]; i < first[b + 1]; ++i) ordering.push_back(i);
+      block_start.push_back(static_cast<int>(ordering.size()));
+    }
+    std::vector<int> position(n);
+    for (int k = 0; k < n; ++k) position[ordering[k]] = k;
+    const PermutedPattern p = PermuteSymmetricBlockPattern(
+        n, outer.data(), inner.data(), position, block_start);
+    ASSERT_EQ(static_cast<int>(p.column_start.size()), n + 1);
+    std::vector<double> permuted(p.row_index.size(), 0.0);
+    for (int c = 0; c < n; ++c) {
+      for (int q = outer[c]; q < outer[c + 1]; ++q) {
+        if (inner[q] < c) {
+          EXPECT_EQ(p.slot[q], -1);
+          continue;
+        }
+        ASSERT_GE(p.slot[q], 0);
+        permuted[p.slot[q]] = value[q];
+      }
+    }
+    // The pattern: the block pairs holding an entry, whole; the values.
+    auto active = [&](int r, int c) {
+      for (int i = first[r]; i < first[r + 1]; ++i) {
+        for (int j = first[c]; j < first[c + 1]; ++j) {
+          if (dense[i][j] != 0) return true;
+        }
+      }
+      return false;
+    };
+    int expected_entries = 0;
+    for (int k = 0; k < n; ++k) {
+      for (int row = 0; row <= k; ++row) {
+        expected_entries +=
+            active(block_of[ordering[row]], block_of[ordering[k]]);
+      }
+      for (int t = p.column_start[k]; t < p.column_start[k + 1]; ++t) {
+        const int row = p.row_index[t];
+        ASSERT_LE(row, k);
+        if (t > p.column_start[k]) {
+          ASSERT_LT(p.row_index[t - 1], row);
+        }
+        EXPECT_TRUE(active(block_of[ordering[row]], block_of[ordering[k]]));
+        EXPECT_EQ(permuted[t], dense[ordering[row]][ordering[k]]);
+      }
+    }
+    EXPECT_EQ(p.column_start[n], expected_entries) << "trial " << trial;
+    // Both analyses; the split however small the matrix.
+    DoubleDoubleCholesky scalar(Split(1)), blocked(Split(1)),
+        scalar_dd(Split(1)), blocked_dd(Split(1));
+    scalar.Analyze(n, p.column_start, p.row_index);
+    blocked.Analyze(n, p.column_start, p.row_index, block_start);
+    scalar_dd.Analyze(n, p.column_start, p.row_index);
+    blocked_dd.Analyze(n, p.column_start, p.row_index, block_start);
+    EXPECT_EQ(blocked.flops(), scalar.flops());
+    EXPECT_EQ(blocked.factor_start(), scalar.factor_start());
+    EXPECT_EQ(blocked.supernode_start(), scalar.supernode_start());
+    EXPECT_EQ(blocked.supernodal_entries(), scalar.supernodal_entries());
+    EXPECT_EQ(blocked.num_bins(), scalar.num_bins());
+    EXPECT_EQ(blocked.factor_row(), scalar.factor_row());
+    std::vector<DoubleDouble> extended(permuted.size());
+    for (size_t t = 0; t < permuted.size(); ++t) {
+      extended[t] = DoubleDouble(permuted[t]);
+    }
+    ASSERT_TRUE(scalar.Factorize(permuted));
+    ASSERT_TRUE(blocked.Factorize(permuted));
+    ASSERT_TRUE(scalar_dd.Factorize(extended));
+    ASSERT_TRUE(blocked_dd.Factorize(extended));
+    EXPECT_EQ(BitwiseDifferences(blocked, scalar), 0) << "trial " << trial;
+    EXPECT_EQ(BitwiseDifferences(blocked_dd, scalar_dd), 0);
+    for (auto [x, y] :
+         {std::pair(&blocked, &scalar), std::pair(&blocked_dd, &scalar_dd)}) {
+      std::vector<double> rho_x, rho_y;
+      x->RowBackwardErrorBounds(&rho_x);
+      y->RowBackwardErrorBounds(&rho_y);
+      EXPECT_EQ(rho_x, rho_y) << "trial " << trial;
+    }
+    // The pattern without the completion, where it differs, is refused.
+    const PermutedPattern incomplete =
+        PermuteSymmetricPattern(n, outer.data(), inner.data(), position);
+    if (incomplete.column_start[n] < p.column_start[n] && refused < 2) {
+      ++refused;
+      DoubleDoubleCholesky refusing;
+      EXPECT_DEATH(refusing.Analyze(n, incomplete.column_start,
+                                    incomplete.row_index, block_start),
+                   "not block-full");
+    }
+  }
+  EXPECT_EQ(refused, 2);
+}
+
 }  // namespace
 }  // namespace ceres_sesync::internal

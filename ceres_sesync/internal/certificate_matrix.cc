@@ -22,21 +22,27 @@ namespace {
 // node and for a world vertex without t_w) and its d rotation unknowns
 // (absent for landmarks), so ordering the vertices (about 1 / (d+1)^2 of K's
 // entries) and expanding gives K's ordering at a fraction of the cost of
-// ordering K itself.
-std::vector<int> BlockOrdering(const SESyncProblem& problem) {
+// ordering K itself. block_start: where each vertex's unknowns begin in it.
+std::vector<int> BlockOrdering(const SESyncProblem& problem,
+                               std::vector<int>* block_start) {
   const ProblemLayout& layout = problem.layout();
   const int n = problem.num_rotations(), d = problem.dimension();
   const int t0 = problem.num_translations() - 1;
   std::vector<int> ordering;
   ordering.reserve(t0 + d * n);
+  block_start->assign(1, 0);
   for (int v : problem.vertex_ordering()) {
     const int node = layout.translation_of_vertex(v);
     if (node >= 0 && layout.reduced(node) >= 0) {
       ordering.push_back(layout.reduced(node));
     }
     const int block = layout.rotation_of_vertex(v);
-    if (block < 0) continue;
-    for (int a = 0; a < d; ++a) ordering.push_back(t0 + d * block + a);
+    if (block >= 0) {
+      for (int a = 0; a < d; ++a) ordering.push_back(t0 + d * block + a);
+    }
+    if (static_cast<int>(ordering.size()) > block_start->back()) {
+      block_start->push_back(static_cast<int>(ordering.size()));
+    }
   }
   return ordering;
 }
@@ -76,14 +82,16 @@ CertificateMatrix::CertificateMatrix(const SESyncProblem& problem)
     }
   }
   SetData(K_);
-  ordering_ = BlockOrdering(problem);
+  std::vector<int> block_start;
+  ordering_ = BlockOrdering(problem, &block_start);
   std::vector<int> permuted_start, permuted_row;
-  InitializePermutedPattern(&permuted_start, &permuted_row);
+  InitializePermutedPattern(block_start, &permuted_start, &permuted_row);
+  pattern_entries_ = permuted_start.back();
   DoubleDoubleCholesky::Options options;
   options.num_threads = problem_.num_threads();
   double_ = std::make_unique<DoubleDoubleCholesky>(options);
   double_->Analyze(static_cast<int>(K_.rows()), std::move(permuted_start),
-                   std::move(permuted_row));
+                   std::move(permuted_row), block_start);
 }
 
 double CertificateMatrix::FactorizationCostInSolves(int r) const {
@@ -248,7 +256,7 @@ bool CertificateMatrix::FactorizeDouble() {
   const auto start = std::chrono::steady_clock::now();
   ++double_factorizations_;
   solver_.reset();
-  std::vector<double> values(K_.nonZeros());
+  std::vector<double> values(pattern_entries_, 0.0);
   for (int q = 0; q < K_.nonZeros(); ++q) {
     values[permuted_index_[q]] = K_.valuePtr()[q];
   }
@@ -327,12 +335,13 @@ bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
 }
 
 void CertificateMatrix::InitializePermutedPattern(
-    std::vector<int>* permuted_start, std::vector<int>* permuted_row) {
+    const std::vector<int>& block_start, std::vector<int>* permuted_start,
+    std::vector<int>* permuted_row) {
   const int size = static_cast<int>(K_.rows());
   position_.resize(size);  // Original index -> pivot order.
   for (int k = 0; k < size; ++k) position_[ordering_[k]] = k;
-  PermutedPattern pattern = PermuteSymmetricPattern(
-      size, K_.outerIndexPtr(), K_.innerIndexPtr(), position_);
+  PermutedPattern pattern = PermuteSymmetricBlockPattern(
+      size, K_.outerIndexPtr(), K_.innerIndexPtr(), position_, block_start);
   *permuted_start = std::move(pattern.column_start);
   *permuted_row = std::move(pattern.row_index);
   permuted_index_ = std::move(pattern.slot);
@@ -415,7 +424,7 @@ bool CertificateMatrix::ProveDoubleDouble(const Eigen::MatrixXd& Lambda,
       });
   for (int attempt = 0; attempt < 3; ++attempt) {
     const double mu = extended_shift_;
-    std::vector<DoubleDouble> values(K_.nonZeros());
+    std::vector<DoubleDouble> values(pattern_entries_);
     std::vector<double> assembly_abs(abs_sum);
     std::vector<int> assembly_count(count);
     for (int q = 0; q < K_.nonZeros(); ++q)

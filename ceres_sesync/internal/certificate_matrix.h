@@ -160,10 +160,13 @@ class CertificateMatrix {
   // The double factorization of K_, counted and timed; true iff it completed.
   bool FactorizeDouble();
   bool ProveDoubleDouble(const Eigen::MatrixXd& Lambda, double c);
-  // K_'s upper triangle permuted by ordering_ in compressed columns (the
-  // factorizations' pattern), the map of its values (permuted_index_) and
-  // position_.
-  void InitializePermutedPattern(std::vector<int>* permuted_start,
+  // K_'s upper triangle permuted by ordering_ in compressed columns,
+  // completed to whole vertex blocks (block_start: where each vertex's
+  // unknowns begin in ordering_; the factorizations' pattern, analyzed by
+  // blocks, with explicit zeros: 0.1-3% more flops than K_'s own pattern on
+  // the datasets), the map of its values (permuted_index_) and position_.
+  void InitializePermutedPattern(const std::vector<int>& block_start,
+                                 std::vector<int>* permuted_start,
                                  std::vector<int>* permuted_row);
   // The double-double factor, sharing the double one's symbolic analysis.
   void InitializeDoubleDouble();
@@ -181,6 +184,7 @@ class CertificateMatrix {
   // Where each value of K_ goes in the factorizations' permuted upper
   // triangle.
   std::vector<int> permuted_index_;
+  int pattern_entries_ = 0;  // Entries of that pattern (K_'s and zeros).
   // Rounding of the stored data matrices, per row of K.
   std::vector<double> data_rounding_;
   // The double factorizations (same scheme as the double-double proofs,

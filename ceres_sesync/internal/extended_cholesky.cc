@@ -535,13 +535,71 @@ DoubleDoubleCholesky::DoubleDoubleCholesky(const Options& options)
       symbolic_(std::make_shared<const Symbolic>()) {}
 
 void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
-                                   std::vector<int> row_index) {
+                                   std::vector<int> row_index,
+                                   const std::vector<int>& block_start) {
   auto fresh = std::make_shared<Symbolic>();
   Symbolic& sym = *fresh;
   sym.n = n;
   sym.column_start = std::move(column_start);
   sym.row_index = std::move(row_index);
   CHECK_EQ(static_cast<int>(sym.column_start.size()), n + 1);
+  if (block_start.empty()) {
+    AnalyzeColumns(&sym);
+    if (options_.supernodal) AnalyzeSupernodes(options_, nullptr, &sym);
+    SetSymbolic(std::move(fresh));
+    return;
+  }
+  CHECK(block_start.front() == 0 && block_start.back() == n);
+  BlockPattern blocks;
+  blocks.block_start = block_start;
+  const int num_blocks = static_cast<int>(block_start.size()) - 1;
+  blocks.block_of.resize(n);
+  for (int b = 0; b < num_blocks; ++b) {
+    CHECK_LT(block_start[b], block_start[b + 1]);
+    std::fill(blocks.block_of.begin() + block_start[b],
+              blocks.block_of.begin() + block_start[b + 1], b);
+  }
+  // Block C's rows from its first column; every column of C must then hold
+  // exactly those blocks whole and C's rows up to the diagonal.
+  std::vector<int> mark(num_blocks, -1);
+  blocks.start.assign(1, 0);
+  for (int c = 0; c < num_blocks; ++c) {
+    mark[c] = c;
+    const int first = block_start[c];
+    for (int p = sym.column_start[first]; p < sym.column_start[first + 1];
+         ++p) {
+      const int b = blocks.block_of[sym.row_index[p]];
+      if (mark[b] != c) {
+        mark[b] = c;
+        blocks.rows.push_back(b);
+      }
+    }
+    std::sort(blocks.rows.begin() + blocks.start.back(), blocks.rows.end());
+    int above = 0;
+    for (int q = blocks.start.back(); q < static_cast<int>(blocks.rows.size());
+         ++q) {
+      above += block_start[blocks.rows[q] + 1] - block_start[blocks.rows[q]];
+    }
+    blocks.start.push_back(static_cast<int>(blocks.rows.size()));
+    for (int j = first; j < block_start[c + 1]; ++j) {
+      CHECK_EQ(sym.column_start[j + 1] - sym.column_start[j],
+               above + (j - first + 1))
+          << "column " << j << ": the pattern is not block-full";
+      for (int p = sym.column_start[j]; p < sym.column_start[j + 1]; ++p) {
+        const int i = sym.row_index[p];
+        CHECK(i <= j && mark[blocks.block_of[i]] == c)
+            << "column " << j << ": the pattern is not block-full";
+      }
+    }
+  }
+  AnalyzeColumns(blocks, &sym);
+  if (options_.supernodal) AnalyzeSupernodes(options_, &blocks, &sym);
+  SetSymbolic(std::move(fresh));
+}
+
+void DoubleDoubleCholesky::AnalyzeColumns(Symbolic* symbolic) {
+  Symbolic& sym = *symbolic;
+  const int n = sym.n;
   // Elimination tree (Liu's algorithm with path compression through
   // `ancestor`).
   sym.parent.assign(n, -1);
@@ -575,8 +633,61 @@ void DoubleDoubleCholesky::Analyze(int n, std::vector<int> column_start,
     sym.factor_start[k + 1] = sym.factor_start[k] + count[k];
     sym.flops += 0.5 * count[k] * static_cast<double>(count[k]);
   }
-  if (options_.supernodal) AnalyzeSupernodes(options_, &sym);
-  SetSymbolic(std::move(fresh));
+}
+
+void DoubleDoubleCholesky::AnalyzeColumns(const BlockPattern& blocks,
+                                          Symbolic* symbolic) {
+  // The same results by blocks. In a block-full pattern eliminated block by
+  // block, column j's parent is j + 1 inside its block and the first column
+  // of the block tree's parent for a block's last column; column (X, jj)
+  // (jj-th of block X's s_X) has s_X - jj entries of X and, whole, every
+  // block whose row reach passes X: the blocks of X's structure. Row i =
+  // (k, ii) has ii + 1 entries in k's columns and s_X in every block X of
+  // its reach.
+  Symbolic& sym = *symbolic;
+  const int n = sym.n;
+  const std::vector<int>& block_start = blocks.block_start;
+  const int num_blocks = static_cast<int>(block_start.size()) - 1;
+  auto size = [&](int b) { return block_start[b + 1] - block_start[b]; };
+  std::vector<int> parent(num_blocks, -1), ancestor(num_blocks, -1);
+  for (int k = 0; k < num_blocks; ++k) {
+    for (int q = blocks.start[k]; q < blocks.start[k + 1]; ++q) {
+      for (int i = blocks.rows[q]; i != -1 && i < k;) {
+        const int next = ancestor[i];
+        ancestor[i] = k;
+        if (next == -1) parent[i] = k;
+        i = next;
+      }
+    }
+  }
+  std::vector<int> below(num_blocks, 0), reach(num_blocks, 0),
+      mark(num_blocks, -1);
+  for (int k = 0; k < num_blocks; ++k) {
+    mark[k] = k;
+    for (int q = blocks.start[k]; q < blocks.start[k + 1]; ++q) {
+      for (int i = blocks.rows[q]; mark[i] != k; i = parent[i]) {
+        mark[i] = k;
+        below[i] += size(k);
+        reach[k] += size(i);
+      }
+    }
+  }
+  sym.parent.resize(n);
+  sym.row_count.resize(n);
+  sym.factor_start.assign(n + 1, 0);
+  sym.flops = 0;
+  for (int b = 0; b < num_blocks; ++b) {
+    const int first = block_start[b], last = block_start[b + 1] - 1;
+    for (int j = first; j <= last; ++j) {
+      sym.parent[j] = j < last         ? j + 1
+                      : parent[b] >= 0 ? block_start[parent[b]]
+                                       : -1;
+      sym.row_count[j] = 1 + (j - first) + reach[b];
+      const int count = last - j + 1 + below[b];
+      sym.factor_start[j + 1] = sym.factor_start[j] + count;
+      sym.flops += 0.5 * count * static_cast<double>(count);
+    }
+  }
 }
 
 void DoubleDoubleCholesky::ShareAnalysis(const DoubleDoubleCholesky& other) {
@@ -600,6 +711,7 @@ void DoubleDoubleCholesky::SetSymbolic(std::shared_ptr<const Symbolic> sym) {
 }
 
 void DoubleDoubleCholesky::AnalyzeSupernodes(const Options& options,
+                                             const BlockPattern* blocks,
                                              Symbolic* symbolic) {
   Symbolic& sym = *symbolic;
   const int n = sym.n;
@@ -669,38 +781,99 @@ void DoubleDoubleCholesky::AnalyzeSupernodes(const Options& options,
   long long total_rows = 0;
   for (int s = 0; s < num_super; ++s) total_rows += count(sym.super_start[s]);
   sym.super_row.reserve(total_rows);
-  std::vector<int> mark(n, -1);
+  std::vector<int> mark(blocks ? 0 : n, -1);
+  // By blocks: the same rows, blockwise (a supernode is a run of whole
+  // blocks: inside a block each column continues the last), from the
+  // blocks' lower pattern and the children's blocks below theirs.
+  std::vector<int> lower_start, lower_block, block_mark, super_block,
+      super_block_start;
+  if (blocks) {
+    const int num_blocks = static_cast<int>(blocks->block_start.size()) - 1;
+    lower_start.assign(num_blocks + 1, 0);
+    for (int b : blocks->rows) ++lower_start[b + 1];
+    for (int b = 0; b < num_blocks; ++b) lower_start[b + 1] += lower_start[b];
+    lower_block.resize(blocks->rows.size());
+    std::vector<int> next(lower_start.begin(), lower_start.end() - 1);
+    for (int k = 0; k < num_blocks; ++k) {
+      for (int q = blocks->start[k]; q < blocks->start[k + 1]; ++q) {
+        lower_block[next[blocks->rows[q]]++] = k;
+      }
+    }
+    block_mark.assign(num_blocks, -1);
+    super_block_start.assign(1, 0);
+  }
   sym.super_row_start.assign(1, 0);
   sym.super_value_start.assign(1, 0);
   for (int s = 0; s < num_super; ++s) {
     const int first = sym.super_start[s], last = sym.super_start[s + 1];
     const int ncols = last - first;
-    for (int j = first; j < last; ++j) {
-      mark[j] = s;
-      sym.super_row.push_back(j);
-    }
-    const size_t below = sym.super_row.size();
-    for (int j = first; j < last; ++j) {
-      for (int q = sym.scatter_start[j]; q < sym.scatter_start[j + 1]; ++q) {
-        const int k = lower_row[q];
-        if (mark[k] != s) {
-          mark[k] = s;
-          sym.super_row.push_back(k);
+    if (blocks) {
+      const int b0 = blocks->block_of[first], b1 = blocks->block_of[last - 1];
+      CHECK(blocks->block_start[b0] == first &&
+            blocks->block_start[b1 + 1] == last)
+          << "supernode " << s << " splits a block";
+      for (int b = b0; b <= b1; ++b) {
+        block_mark[b] = s;
+        super_block.push_back(b);
+      }
+      const size_t below = super_block.size();
+      auto add = [&](int k) {
+        if (block_mark[k] != s) {
+          block_mark[k] = s;
+          super_block.push_back(k);
+        }
+      };
+      for (int b = b0; b <= b1; ++b) {
+        for (int q = lower_start[b]; q < lower_start[b + 1]; ++q) {
+          add(lower_block[q]);
         }
       }
-    }
-    for (int c = child_head[s]; c != -1; c = child_next[c]) {
-      const int c_cols = sym.super_start[c + 1] - sym.super_start[c];
-      for (int t = sym.super_row_start[c] + c_cols;
-           t < sym.super_row_start[c + 1]; ++t) {
-        const int k = sym.super_row[t];
-        if (mark[k] != s) {
-          mark[k] = s;
-          sym.super_row.push_back(k);
+      for (int c = child_head[s]; c != -1; c = child_next[c]) {
+        const int own = blocks->block_of[sym.super_start[c + 1] - 1] -
+                        blocks->block_of[sym.super_start[c]] + 1;
+        for (int t = super_block_start[c] + own; t < super_block_start[c + 1];
+             ++t) {
+          add(super_block[t]);
         }
       }
+      std::sort(super_block.begin() + below, super_block.end());
+      super_block_start.push_back(static_cast<int>(super_block.size()));
+      for (int j = first; j < last; ++j) sym.super_row.push_back(j);
+      for (size_t t = below; t < super_block.size(); ++t) {
+        const int k = super_block[t];
+        for (int i = blocks->block_start[k]; i < blocks->block_start[k + 1];
+             ++i) {
+          sym.super_row.push_back(i);
+        }
+      }
+    } else {
+      for (int j = first; j < last; ++j) {
+        mark[j] = s;
+        sym.super_row.push_back(j);
+      }
+      const size_t below = sym.super_row.size();
+      for (int j = first; j < last; ++j) {
+        for (int q = sym.scatter_start[j]; q < sym.scatter_start[j + 1]; ++q) {
+          const int k = lower_row[q];
+          if (mark[k] != s) {
+            mark[k] = s;
+            sym.super_row.push_back(k);
+          }
+        }
+      }
+      for (int c = child_head[s]; c != -1; c = child_next[c]) {
+        const int c_cols = sym.super_start[c + 1] - sym.super_start[c];
+        for (int t = sym.super_row_start[c] + c_cols;
+             t < sym.super_row_start[c + 1]; ++t) {
+          const int k = sym.super_row[t];
+          if (mark[k] != s) {
+            mark[k] = s;
+            sym.super_row.push_back(k);
+          }
+        }
+      }
+      std::sort(sym.super_row.begin() + below, sym.super_row.end());
     }
-    std::sort(sym.super_row.begin() + below, sym.super_row.end());
     sym.super_row_start.push_back(static_cast<int>(sym.super_row.size()));
     const long long nrows = sym.super_row_start[s + 1] - sym.super_row_start[s];
     CHECK_EQ(nrows, count(first)) << "supernode " << s << ": its rows and "
@@ -1165,6 +1338,101 @@ PermutedPattern PermuteSymmetricPattern(int n, const int* outer,
       p.slot[q] = slot;
     }
   }
+  return p;
+}
+
+PermutedPattern PermuteSymmetricBlockPattern(
+    int n, const int* outer, const int* inner, const std::vector<int>& position,
+    const std::vector<int>& block_start) {
+  CHECK(!block_start.empty() && block_start.front() == 0 &&
+        block_start.back() == n);
+  const int num_blocks = static_cast<int>(block_start.size()) - 1;
+  std::vector<int> block_of(n);
+  for (int b = 0; b < num_blocks; ++b) {
+    std::fill(block_of.begin() + block_start[b],
+              block_of.begin() + block_start[b + 1], b);
+  }
+  // The block pairs (hi >= lo) of the entries, one per run of a column's
+  // entries in the same pair; slot holds each entry's pair until step 5.
+  PermutedPattern p;
+  p.slot.assign(outer[n], -1);
+  std::vector<int> pair_hi, pair_lo;
+  auto for_each_entry = [&](auto&& f) {
+    for (int c = 0; c < n; ++c) {
+      for (int q = outer[c]; q < outer[c + 1]; ++q) {
+        if (inner[q] < c) continue;
+        const int pr = position[inner[q]], pc = position[c];
+        f(q, std::min(pr, pc), std::max(pr, pc));
+      }
+    }
+  };
+  int last_hi = -1, last_lo = -1;
+  for_each_entry([&](int q, int lo, int hi) {
+    const int b_hi = block_of[hi], b_lo = block_of[lo];
+    if (b_hi != last_hi || b_lo != last_lo) {
+      pair_hi.push_back(last_hi = b_hi);
+      pair_lo.push_back(last_lo = b_lo);
+    }
+    p.slot[q] = static_cast<int>(pair_hi.size()) - 1;
+  });
+  // 2. The pairs by block column.
+  const int num_pairs = static_cast<int>(pair_hi.size());
+  std::vector<int> pair_start(num_blocks + 1, 0), by_column(num_pairs);
+  for (int b : pair_hi) ++pair_start[b + 1];
+  for (int b = 0; b < num_blocks; ++b) pair_start[b + 1] += pair_start[b];
+  {
+    std::vector<int> next(pair_start.begin(), pair_start.end() - 1);
+    for (int k = 0; k < num_pairs; ++k) by_column[next[pair_hi[k]]++] = k;
+  }
+  // 3. Block column C's rows R < C ascending, the scalar rows above each
+  // (offset; C's own rows follow them), each pair's offset, the columns'
+  // starts.
+  std::vector<int> row_start(1, 0), rows, seen(num_blocks, -1),
+      offset(num_blocks), pair_offset(num_pairs);
+  p.column_start.assign(n + 1, 0);
+  for (int c = 0; c < num_blocks; ++c) {
+    const size_t first = rows.size();
+    for (int t = pair_start[c]; t < pair_start[c + 1]; ++t) {
+      const int r = pair_lo[by_column[t]];
+      if (r != c && seen[r] != c) {
+        seen[r] = c;
+        rows.push_back(r);
+      }
+    }
+    std::sort(rows.begin() + first, rows.end());
+    int above = 0;
+    for (size_t t = first; t < rows.size(); ++t) {
+      offset[rows[t]] = above;
+      above += block_start[rows[t] + 1] - block_start[rows[t]];
+    }
+    offset[c] = above;
+    for (int t = pair_start[c]; t < pair_start[c + 1]; ++t) {
+      pair_offset[by_column[t]] = offset[pair_lo[by_column[t]]];
+    }
+    row_start.push_back(static_cast<int>(rows.size()));
+    for (int j = block_start[c]; j < block_start[c + 1]; ++j) {
+      p.column_start[j + 1] =
+          p.column_start[j] + above + (j - block_start[c]) + 1;
+    }
+  }
+  // 4. The rows: the blocks above, whole, then C's up to the diagonal.
+  p.row_index.resize(p.column_start[n]);
+  for (int c = 0; c < num_blocks; ++c) {
+    for (int j = block_start[c]; j < block_start[c + 1]; ++j) {
+      int at = p.column_start[j];
+      for (int t = row_start[c]; t < row_start[c + 1]; ++t) {
+        for (int i = block_start[rows[t]]; i < block_start[rows[t] + 1]; ++i) {
+          p.row_index[at++] = i;
+        }
+      }
+      for (int i = block_start[c]; i <= j; ++i) p.row_index[at++] = i;
+    }
+  }
+  // 5. Each entry's place: its pair's offset in its column.
+  for_each_entry([&](int q, int lo, int hi) {
+    p.slot[q] = p.column_start[hi] + pair_offset[p.slot[q]] +
+                (lo - block_start[block_of[lo]]);
+  });
   return p;
 }
 

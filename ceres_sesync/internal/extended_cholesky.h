@@ -81,8 +81,18 @@ class DoubleDoubleCholesky {
   // Symbolic analysis of the n x n pattern: column k of the upper triangle
   // holds the rows row_index[column_start[k] .. column_start[k+1]) (each
   // <= k, no duplicates; the diagonal must be present). O(nnz(L)).
-  void Analyze(int n, std::vector<int> column_start,
-               std::vector<int> row_index);
+  //
+  // With `block_start` (0 = block_start[0] < ... < block_start.back() = n),
+  // the columns form consecutive blocks and the pattern must be block-full:
+  // where two blocks share an entry they share all (the diagonal blocks
+  // full), as in matrices of d x d blocks per pose in an ordering that keeps
+  // each pose's unknowns together. The analysis is then that of the same
+  // scalar pattern, with the elimination tree, the counts and the
+  // supernodes' rows computed on the blocks (the maps of the values stay
+  // per entry: kitti_00's analyses take ~16% less time).
+  // CHECK-fails on a pattern that is not block-full.
+  void Analyze(int n, std::vector<int> column_start, std::vector<int> row_index,
+               const std::vector<int>& block_start = {});
   // Uses `other`'s analysis (supernodal, the same min_split_flops) instead
   // of running Analyze() again on the same pattern: the analysis is
   // immutable and shared, the numeric factors stay separate. Costs O(1).
@@ -193,7 +203,17 @@ class DoubleDoubleCholesky {
     std::vector<int> scatter_start, scatter_source;
     std::vector<long long> scatter_destination;
   };
-  static void AnalyzeSupernodes(const Options& options, Symbolic* symbolic);
+  // The block pattern of a block-full Analyze(): block C's rows R < C (in
+  // increasing order) at rows[start[C] ..], and the block of each column.
+  struct BlockPattern {
+    std::vector<int> block_start, start, rows, block_of;
+  };
+  // The elimination tree, counts and flops of the pattern, scalar or by its
+  // blocks.
+  static void AnalyzeColumns(Symbolic* symbolic);
+  static void AnalyzeColumns(const BlockPattern& blocks, Symbolic* symbolic);
+  static void AnalyzeSupernodes(const Options& options,
+                                const BlockPattern* blocks, Symbolic* symbolic);
   // Installs an analysis and drops any numeric factor.
   void SetSymbolic(std::shared_ptr<const Symbolic> symbolic);
   // f(row, value) for every entry of column c of L in order (the diagonal
@@ -258,6 +278,12 @@ class DoubleDoubleCholesky {
 struct PermutedPattern {
   std::vector<int> column_start, row_index, slot;
 };
+// The same, completed to the block-full pattern of the blocks block_start
+// (in pivot order: see Analyze()): the pattern gains the explicit zeros that
+// make every block pair with an entry whole. Rows within a column ascend.
+PermutedPattern PermuteSymmetricBlockPattern(
+    int n, const int* outer, const int* inner, const std::vector<int>& position,
+    const std::vector<int>& block_start);
 PermutedPattern PermuteSymmetricPattern(int n, const int* outer,
                                         const int* inner,
                                         const std::vector<int>& position);

@@ -129,9 +129,13 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
     }
   }
   CHECK_EQ(static_cast<int>(unknowns_.size()), num_unknowns_);
+  std::vector<int> block_start(1, 0);  // Each vertex's unknowns, pivots.
   for (int v : problem.vertex_ordering()) {
     for (int t = unknown_start_[v]; t < unknown_start_[v + 1]; ++t) {
       ordering_.push_back(unknowns_[t]);
+    }
+    if (static_cast<int>(ordering_.size()) > block_start.back()) {
+      block_start.push_back(static_cast<int>(ordering_.size()));
     }
   }
   CHECK_EQ(static_cast<int>(ordering_.size()), num_unknowns_);
@@ -168,8 +172,9 @@ TangentNewton::TangentNewton(const SESyncProblem& problem)
   DoubleDoubleCholesky::Options options;
   options.num_threads = problem.num_threads();
   cholesky_ = std::make_unique<DoubleDoubleCholesky>(options);
+  // Whole blocks per vertex pair: analyzed by blocks.
   cholesky_->Analyze(num_unknowns_, std::move(column_start),
-                     std::move(row_index));
+                     std::move(row_index), block_start);
   values_.resize(slot_.size());
 }
 
