@@ -886,6 +886,48 @@ TEST(SESyncPreconditioner, AllTypesAreDocumentedOperatorsAndSpdOnTangent) {
 
 // kAdaptive: block-Jacobi until a rule of PreconditionerSettings fires, then
 // the exact (Q + eps I)^{-1}, with the documented operators before and after.
+// Block-Jacobi's inverses (computed when first applied) follow the data
+// matrices: after UpdateWeights() and Refresh(), Apply() is the block
+// inverse of the new D + eps I, for kBlockJacobi and kAdaptive alike.
+TEST(SESyncPreconditioner, BlockJacobiFollowsTheWeights) {
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> uniform(0.3, 1.0);
+  for (int d : {2, 3}) {
+    RandomGraphOptions o;
+    o.dimension = d;
+    o.num_poses = 20;
+    o.num_loop_closures = 15;
+    o.seed = 400 + d;
+    const PoseGraph graph = RandomPoseGraph(o, nullptr);
+    internal::MeasurementWeights weights(graph.measurements.size(), 1.0);
+    SESyncProblem problem(graph, 1, weights);
+    ASSERT_TRUE(problem.ok());
+    const int n = problem.num_rotations(), dn = d * n;
+    for (PreconditionerType type :
+         {PreconditionerType::kBlockJacobi, PreconditionerType::kAdaptive}) {
+      SESyncPreconditioner preconditioner(problem, type, 1e6);
+      for (int round = 0; round < 2; ++round) {
+        const MatrixXd D = MatrixXd(problem.D());
+        const double eps = D.cwiseAbs().rowwise().sum().maxCoeff() / 1e6;
+        MatrixXd block_jacobi = MatrixXd::Zero(dn, dn);
+        for (int i = 0; i < n; ++i) {
+          block_jacobi.block(d * i, d * i, d, d) =
+              (D.block(d * i, d * i, d, d) + eps * MatrixXd::Identity(d, d))
+                  .inverse();
+        }
+        const MatrixXd V = Gaussian(3, dn, &rng);
+        MatrixXd X;
+        preconditioner.Apply(V, &X);
+        EXPECT_LT(RelativeError(X, V * block_jacobi), 1e-8)
+            << "d " << d << " round " << round;
+        for (double& w : weights) w = uniform(rng);
+        ASSERT_TRUE(problem.UpdateWeights(weights));
+        preconditioner.Refresh();
+      }
+    }
+  }
+}
+
 TEST(SESyncPreconditioner, AdaptiveSwitchesByItsRules) {
   std::mt19937_64 rng(37);
   RandomGraphOptions o;
