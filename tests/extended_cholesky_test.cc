@@ -549,6 +549,52 @@ TEST(ExtendedCholesky, RejectsIndefiniteMatrices) {
 // A's diagonal lands once, at (min, max) of its pivots, with its value;
 // entries above the diagonal are skipped. Random patterns (both triangles,
 // and the lower one alone) and random permutations.
+// A dense symmetric matrix in compressed columns (rows ascending): both
+// triangles, or the lower one.
+struct Compressed {
+  std::vector<int> outer{0}, inner;
+  std::vector<double> value;
+};
+Compressed CompressColumns(const std::vector<std::vector<double>>& dense,
+                           bool lower_only) {
+  const int n = static_cast<int>(dense.size());
+  Compressed a;
+  for (int c = 0; c < n; ++c) {
+    for (int r = lower_only ? c : 0; r < n; ++r) {
+      if (dense[r][c] != 0) {
+        a.inner.push_back(r);
+        a.value.push_back(dense[r][c]);
+      }
+    }
+    a.outer.push_back(static_cast<int>(a.inner.size()));
+  }
+  return a;
+}
+
+// a's values of the lower triangle at their slots of p (zero elsewhere);
+// filled[t]: how many values went to slot t. Entries above the diagonal
+// must have no slot.
+std::vector<double> PlaceValues(const Compressed& a, const PermutedPattern& p,
+                                std::vector<int>* filled) {
+  std::vector<double> permuted(p.row_index.size(), 0.0);
+  filled->assign(p.row_index.size(), 0);
+  EXPECT_EQ(p.slot.size(), a.inner.size());
+  const int n = static_cast<int>(a.outer.size()) - 1;
+  for (int c = 0; c < n; ++c) {
+    for (int q = a.outer[c]; q < a.outer[c + 1]; ++q) {
+      if (a.inner[q] < c) {
+        EXPECT_EQ(p.slot[q], -1);
+        continue;
+      }
+      EXPECT_GE(p.slot[q], 0);
+      if (p.slot[q] < 0) continue;
+      permuted[p.slot[q]] = a.value[q];
+      ++(*filled)[p.slot[q]];
+    }
+  }
+  return permuted;
+}
+
 TEST(ExtendedCholesky, PermuteSymmetricPatternMatchesDensePermutation) {
   std::mt19937 rng(5);
   for (int trial = 0; trial < 20; ++trial) {
@@ -562,40 +608,17 @@ TEST(ExtendedCholesky, PermuteSymmetricPatternMatchesDensePermutation) {
         if (rng() % 4 == 0) dense[i][j] = dense[j][i] = uniform(rng);
       }
     }
-    // Compressed columns of A (rows ascending).
-    std::vector<int> outer(1, 0), inner;
-    std::vector<double> value;
-    for (int c = 0; c < n; ++c) {
-      for (int r = lower_only ? c : 0; r < n; ++r) {
-        if (dense[r][c] != 0) {
-          inner.push_back(r);
-          value.push_back(dense[r][c]);
-        }
-      }
-      outer.push_back(static_cast<int>(inner.size()));
-    }
+    const Compressed a = CompressColumns(dense, lower_only);
     std::vector<int> ordering(n);
     for (int k = 0; k < n; ++k) ordering[k] = k;
     std::shuffle(ordering.begin(), ordering.end(), rng);
     std::vector<int> position(n);
     for (int k = 0; k < n; ++k) position[ordering[k]] = k;
     const PermutedPattern p =
-        PermuteSymmetricPattern(n, outer.data(), inner.data(), position);
+        PermuteSymmetricPattern(n, a.outer.data(), a.inner.data(), position);
     ASSERT_EQ(static_cast<int>(p.column_start.size()), n + 1);
-    ASSERT_EQ(p.slot.size(), inner.size());
-    std::vector<double> permuted(p.row_index.size(), 0.0);
-    std::vector<int> filled(p.row_index.size(), 0);
-    for (int c = 0; c < n; ++c) {
-      for (int q = outer[c]; q < outer[c + 1]; ++q) {
-        if (inner[q] < c) {
-          EXPECT_EQ(p.slot[q], -1);
-          continue;
-        }
-        ASSERT_GE(p.slot[q], 0);
-        permuted[p.slot[q]] = value[q];
-        ++filled[p.slot[q]];
-      }
-    }
+    std::vector<int> filled;
+    const std::vector<double> permuted = PlaceValues(a, p, &filled);
     EXPECT_TRUE(std::all_of(filled.begin(), filled.end(),
                             [](int f) { return f == 1; }));
     // The upper triangle of P A P^T, entry by entry.
@@ -661,17 +684,7 @@ TEST(ExtendedCholesky, BlockAnalysisEqualsScalarAnalysis) {
       for (int j = 0; j < n; ++j) sum += std::abs(dense[i][j]);
       dense[i][i] = sum;
     }
-    std::vector<int> outer(1, 0), inner;
-    std::vector<double> value;
-    for (int c = 0; c < n; ++c) {
-      for (int r = 0; r < n; ++r) {
-        if (dense[r][c] != 0) {
-          inner.push_back(r);
-          value.push_back(dense[r][c]);
-        }
-      }
-      outer.push_back(static_cast<int>(inner.size()));
-    }
+    const Compressed a = CompressColumns(dense, /*lower_only=*/false);
     // Blocks in a random order, each block's unknowns together.
     std::vector<int> block_order(num_blocks);
     for (int b = 0; b < num_blocks; ++b) block_order[b] = b;
@@ -684,19 +697,12 @@ TEST(ExtendedCholesky, BlockAnalysisEqualsScalarAnalysis) {
     std::vector<int> position(n);
     for (int k = 0; k < n; ++k) position[ordering[k]] = k;
     const PermutedPattern p = PermuteSymmetricBlockPattern(
-        n, outer.data(), inner.data(), position, block_start);
+        n, a.outer.data(), a.inner.data(), position, block_start);
     ASSERT_EQ(static_cast<int>(p.column_start.size()), n + 1);
-    std::vector<double> permuted(p.row_index.size(), 0.0);
-    for (int c = 0; c < n; ++c) {
-      for (int q = outer[c]; q < outer[c + 1]; ++q) {
-        if (inner[q] < c) {
-          EXPECT_EQ(p.slot[q], -1);
-          continue;
-        }
-        ASSERT_GE(p.slot[q], 0);
-        permuted[p.slot[q]] = value[q];
-      }
-    }
+    std::vector<int> filled;
+    const std::vector<double> permuted = PlaceValues(a, p, &filled);
+    EXPECT_TRUE(std::all_of(filled.begin(), filled.end(),
+                            [](int f) { return f <= 1; }));
     // The pattern: the block pairs holding an entry, whole; the values.
     auto active = [&](int r, int c) {
       for (int i = first[r]; i < first[r + 1]; ++i) {
@@ -755,7 +761,7 @@ TEST(ExtendedCholesky, BlockAnalysisEqualsScalarAnalysis) {
     }
     // The pattern without the completion, where it differs, is refused.
     const PermutedPattern incomplete =
-        PermuteSymmetricPattern(n, outer.data(), inner.data(), position);
+        PermuteSymmetricPattern(n, a.outer.data(), a.inner.data(), position);
     if (incomplete.column_start[n] < p.column_start[n] && refused < 2) {
       ++refused;
       DoubleDoubleCholesky refusing;
