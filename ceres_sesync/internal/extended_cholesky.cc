@@ -1352,7 +1352,7 @@ PermutedPattern PermuteSymmetricBlockPattern(
     std::fill(block_of.begin() + block_start[b],
               block_of.begin() + block_start[b + 1], b);
   }
-  // The block pairs (hi >= lo) of the entries, one per run of a column's
+  // 1. The block pairs (hi >= lo) of the entries, one per run of a column's
   // entries in the same pair; slot holds each entry's pair until step 5.
   PermutedPattern p;
   p.slot.assign(outer[n], -1);
