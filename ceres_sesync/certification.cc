@@ -137,24 +137,12 @@ bool Certify(const PoseGraph& graph, const Solution& candidate_solution,
         verification.policy = internal::ProofPolicy::kDoubleDouble;
         break;
     }
-    // The candidate's spread from the gauge node (see VerificationOptions):
-    // pose 0, or the world origin t_w = 0.
-    const Eigen::VectorXd origin = layout.world_translation
-                                       ? Eigen::VectorXd::Zero(d)
-                                       : Eigen::VectorXd(projected[0].t);
-    for (int a = 0; a < d; ++a) {
-      double sum = 0;
-      for (int i = 0; i < n; ++i) {
-        const double x = projected[i].t(a) - origin(a);
-        sum += x * x;
-      }
-      for (const Eigen::VectorXd& p : landmarks) {
-        sum += (p(a) - origin(a)) * (p(a) - origin(a));
-      }
-      verification.translation_spread =
-          std::max(verification.translation_spread, sum / n_rot);
-    }
     internal::CertificateMatrix matrix(problem);
+    // The translations that are optimal for the rotations (those of Q, and
+    // so of S's near-null global rotations), from the gauge's: what double
+    // proofs' translation shifts cost (see VerificationOptions).
+    verification.translation_offsets =
+        matrix.TranslationOffsets(problem.RecoverTranslations(R));
     const internal::VerificationResult v =
         internal::VerifyCertificate(problem, Lambda, verification, &matrix);
     c.eta = v.eta;

@@ -15,6 +15,7 @@
 
 #include "ceres_sesync/internal/certificate_matrix.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "Eigen/Dense"
+#include "ceres_sesync/cube_generator.h"
 #include "ceres_sesync/internal/sesync_cost.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/internal/verification.h"
@@ -328,10 +330,17 @@ TEST_F(CertificateTest, SolveShiftedMatchesDenseSolve) {
                           : matrix.Factorize(in.Lambda, c));
         // The factor is of K_c with the translation block Lbar - mu I: its
         // Schur complement S_mu + cI, computed densely here.
-        const double mu = matrix.translation_shift();
-        EXPECT_EQ(mu > 0, proof);
+        // Lbar - diag(mu_j), mu_j > 0 (one per translation row) after a
+        // proof, none after Factorize().
+        const std::vector<double>& mu = matrix.translation_shifts();
         const int n1 = static_cast<int>(blocks.Lbar.rows());
-        const MatrixXd Lbar = blocks.Lbar - mu * MatrixXd::Identity(n1, n1);
+        ASSERT_EQ(static_cast<int>(mu.size()), proof ? n1 : 0);
+        VectorXd shift = VectorXd::Zero(n1);
+        for (int j = 0; j < static_cast<int>(mu.size()); ++j) {
+          EXPECT_GT(mu[j], 0);
+          shift(j) = mu[j];
+        }
+        const MatrixXd Lbar = blocks.Lbar - MatrixXd(shift.asDiagonal());
         const MatrixXd& V = blocks.Vbar;
         const MatrixXd S_mu = blocks.D - V.transpose() * Lbar.llt().solve(V) -
                               test_util::BlockDiagonalToDense(in.Lambda, in.d);
@@ -473,6 +482,205 @@ TEST_F(CertificateTest, VerificationStopsAtItsDeadline) {
       internal::VerifyCertificate(*problem_, in.Lambda, options, &matrix);
   EXPECT_FALSE(on_time.out_of_time);
   EXPECT_TRUE(on_time.certified);
+}
+
+// DoubleShiftCost is the first-order change of lambda_min(S) that the
+// double proofs' translation shifts cause. At a square grid's certified
+// optimum (S >= 0, its null space the rows of R), Lbar lowered by sigma
+// diag(mu), mu the shifts the next proof starts with, lowers lambda_min(S)
+// by sigma DoubleShiftCost to first order. Pose 0 is a corner of the grid:
+// the offsets' coordinates are correlated, and the cost (the largest
+// eigenvalue of sum_j mu_j o_j o_j^T / n) is well above either coordinate's
+// sum alone.
+TEST(CertificateMatrixShifts, DoubleShiftCostIsTheFirstOrderChange) {
+  CubeOptions o;
+  o.dimension = 2;
+  o.side = 8;
+  o.kappa = 100;
+  o.tau = 100;
+  o.seed = 3;
+  o.loop_closure_probability = 0.3;
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(GenerateCube(o, &graph, nullptr, &error)) << error;
+  SolverOptions options;
+  options.num_threads = 1;
+  SolverSummary summary;
+  const Poses x = Solve(graph, options, &summary);
+  ASSERT_TRUE(summary.certified()) << summary.FullReport();
+  SESyncProblem problem(graph);
+  ASSERT_TRUE(problem.ok());
+  SESyncPreconditioner none(problem, PreconditionerType::kNone, 1e6);
+  SESyncCost cost(&problem, &none);
+  const MatrixXd R = test_util::StackRotations(x);
+  cost.Evaluate(R);
+  const MatrixXd Lambda = cost.Lambda();
+  CertificateMatrix matrix(problem);
+  const MatrixXd offsets =
+      matrix.TranslationOffsets(problem.RecoverTranslations(R));
+  const double model = matrix.DoubleShiftCost(offsets);
+  const std::vector<double>& mu = matrix.next_double_shifts();
+  const int n1 = static_cast<int>(offsets.cols()), n = graph.num_poses;
+  ASSERT_EQ(static_cast<int>(mu.size()), n1);
+  VectorXd shift(n1);
+  double largest_coordinate = 0;
+  for (int j = 0; j < n1; ++j) shift(j) = mu[j];
+  for (int a = 0; a < 2; ++a) {
+    largest_coordinate =
+        std::max(largest_coordinate,
+                 shift.dot(offsets.row(a).transpose().cwiseAbs2()) / n);
+  }
+  EXPECT_GT(model, 1.3 * largest_coordinate);  // The premise: a corner.
+
+  const test_util::DenseLandmarkProblem blocks =
+      test_util::BuildDenseLandmarkProblem(graph);
+  const MatrixXd LambdaDense = test_util::BlockDiagonalToDense(Lambda, 2);
+  auto lambda_min = [&](double sigma) {
+    const MatrixXd Lbar = blocks.Lbar - sigma * MatrixXd(shift.asDiagonal());
+    const MatrixXd S = blocks.D -
+                       blocks.Vbar.transpose() * Lbar.llt().solve(blocks.Vbar) -
+                       LambdaDense;
+    return Eigen::SelfAdjointEigenSolver<MatrixXd>(S, Eigen::EigenvaluesOnly)
+        .eigenvalues()(0);
+  };
+  const double scale = std::abs(lambda_min(0)) +
+                       Eigen::SelfAdjointEigenSolver<MatrixXd>(
+                           blocks.D - LambdaDense, Eigen::EigenvaluesOnly)
+                           .eigenvalues()
+                           .cwiseAbs()
+                           .maxCoeff();
+  // A change of 1e-6 ||S||: far above the dense eigensolver's round-off,
+  // far below S's gap above its null space.
+  const double sigma = 1e-6 * scale / model;
+  const double change = lambda_min(0) - lambda_min(sigma);
+  EXPECT_NEAR(change / (sigma * model), 1.0, 0.02)
+      << "change " << change << " model " << sigma * model;
+}
+
+// A double proof covers every translation row's round-off bound with that
+// row's own shift: started from shifts far too small (1e-300), the first
+// attempt settles no row, the second starts each row at twice its bound and
+// settles. Afterwards the next shifts (1.5 times the bounds met) are within
+// 1.5 times the shifts the proof used, row by row, the shifts vary across
+// rows (10-1000x on maps; here the rows near the top of the elimination
+// tree carry more round-off), and a proof at the same c from the next
+// shifts uses them unchanged.
+TEST(CertificateMatrixShifts, EveryTranslationRowIsCoveredByItsShift) {
+  CubeOptions o;
+  o.dimension = 2;
+  o.side = 8;
+  o.kappa = 100;
+  o.tau = 100;
+  o.seed = 3;
+  o.loop_closure_probability = 0.3;
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(GenerateCube(o, &graph, nullptr, &error)) << error;
+  SolverOptions options;
+  options.num_threads = 1;
+  SolverSummary summary;
+  const Poses x = Solve(graph, options, &summary);
+  ASSERT_TRUE(summary.certified()) << summary.FullReport();
+  SESyncProblem problem(graph);
+  ASSERT_TRUE(problem.ok());
+  SESyncPreconditioner none(problem, PreconditionerType::kNone, 1e6);
+  SESyncCost cost(&problem, &none);
+  cost.Evaluate(test_util::StackRotations(x));
+  const MatrixXd Lambda = cost.Lambda();
+  CertificateMatrix matrix(problem);
+  const int n1 = graph.num_poses - 1;
+  const double c = 1e-6 * cost.Evaluate(test_util::StackRotations(x));
+  matrix.set_next_double_shifts(std::vector<double>(n1, 1e-300));
+  const int before = matrix.double_factorizations();
+  ASSERT_TRUE(matrix.Prove(Lambda, c, internal::ProofPrecision::kDouble));
+  EXPECT_EQ(matrix.double_factorizations() - before, 2);
+  const std::vector<double> used = matrix.translation_shifts();
+  const std::vector<double> next = matrix.next_double_shifts();
+  ASSERT_EQ(static_cast<int>(used.size()), n1);
+  ASSERT_EQ(static_cast<int>(next.size()), n1);
+  for (int j = 0; j < n1; ++j) {
+    EXPECT_GT(used[j], 1e-300) << j;
+    EXPECT_LE(next[j], 1.5 * used[j] * (1 + 1e-12)) << j;
+  }
+  const auto [smallest, largest] =
+      std::minmax_element(used.begin(), used.end());
+  EXPECT_GT(*largest, 10 * *smallest);
+  ASSERT_TRUE(matrix.Prove(Lambda, c, internal::ProofPrecision::kDouble));
+  EXPECT_EQ(matrix.double_factorizations() - before, 3);
+  EXPECT_EQ(matrix.translation_shifts(), next);
+}
+
+// Where double cannot reach the goal with a fresh matrix's shifts (from
+// Lbar's round-off) but the bounds of a first double proof bring it within
+// reach, VerifyCertificate proves in double twice (the second proof with
+// the first's bounds as shifts) instead of once in double-double, on
+// factorizations of at least learned_shift_min_multiply_adds: sound against
+// the dense lambda_min(S), and within half the goal. Below that size (the
+// default's 1e7 here) one double-double proof, as before.
+TEST(CertificateMatrixShifts, LearnedShiftsProveTheGoalInDouble) {
+  CubeOptions o;
+  o.dimension = 2;
+  o.side = 16;
+  o.kappa = 3e3;
+  o.tau = 3e3;
+  o.seed = 1;
+  o.loop_closure_probability = 0.1;
+  PoseGraph graph;
+  std::string error;
+  ASSERT_TRUE(GenerateCube(o, &graph, nullptr, &error)) << error;
+  SolverOptions solver_options;
+  solver_options.num_threads = 1;
+  SolverSummary summary;
+  const Poses x = Solve(graph, solver_options, &summary);
+  ASSERT_TRUE(summary.certified()) << summary.FullReport();
+  SESyncProblem problem(graph);
+  ASSERT_TRUE(problem.ok());
+  SESyncPreconditioner none(problem, PreconditionerType::kNone, 1e6);
+  SESyncCost cost(&problem, &none);
+  const MatrixXd R = test_util::StackRotations(x);
+  const double f = cost.Evaluate(R);
+  const MatrixXd Lambda = cost.Lambda();
+  const int dn = 2 * graph.num_poses;
+  internal::VerificationOptions options;
+  options.eta_target = 1e-9 * f / dn;
+  options.eta_goal = 1e-6 * f / dn;
+  options.eta_max = 1e-3 * f / dn;
+  options.likely_optimal = true;
+  CertificateMatrix fresh(problem);
+  options.translation_offsets =
+      fresh.TranslationOffsets(problem.RecoverTranslations(R));
+  // The premise: double's floor with a fresh matrix's shifts is above a
+  // quarter of the goal (no double proof first) and within the reach.
+  const double floor = fresh.DoubleShiftCost(options.translation_offsets);
+  ASSERT_GT(floor, options.eta_goal / 4);
+  ASSERT_LE(floor, 2 * options.eta_goal);
+  ASSERT_LT(fresh.factorization_flops(),
+            options.learned_shift_min_multiply_adds);
+
+  const MatrixXd S =
+      test_util::DenseQ(graph) - test_util::BlockDiagonalToDense(Lambda, 2);
+  const double lambda_min =
+      Eigen::SelfAdjointEigenSolver<MatrixXd>(S, Eigen::EigenvaluesOnly)
+          .eigenvalues()(0);
+
+  const VerificationResult small =
+      internal::VerifyCertificate(problem, Lambda, options, &fresh);
+  ASSERT_TRUE(small.certified);
+  EXPECT_EQ(small.factorizations, 0);
+  EXPECT_EQ(small.extended_factorizations, 1);
+
+  options.learned_shift_min_multiply_adds = 0;
+  CertificateMatrix matrix(problem);
+  const VerificationResult v =
+      internal::VerifyCertificate(problem, Lambda, options, &matrix);
+  ASSERT_TRUE(v.certified);
+  EXPECT_EQ(v.precision, internal::ProofPrecision::kDouble);
+  EXPECT_EQ(v.extended_factorizations, 0);
+  EXPECT_EQ(v.factorizations, 2);
+  EXPECT_LE(v.eta, options.eta_goal / 2);
+  EXPECT_GE(lambda_min, -v.eta) << "FALSE CERTIFICATE at eta " << v.eta;
+  // The learned shifts cost 3x+ less than the first.
+  EXPECT_LT(3 * matrix.DoubleShiftCost(options.translation_offsets), floor);
 }
 
 }  // namespace

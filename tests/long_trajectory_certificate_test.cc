@@ -231,26 +231,23 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
       c.d, c.n, c.step * c.n, v.eta, internal::ProofPrecisionName(v.precision),
       true_shift, options.eta_goal);
 
-  // As the staircase calls it: with the candidate's translation spread
-  // (max over coordinates of sum_i (t_i - t_0)^2 / n) and the hint that it
-  // is probably optimal. Double cannot reach the goal here, and the one
-  // double-double factorization is all it takes (no double one); the
-  // proven shift is as sound and as tight.
-  double spread = 0;
-  for (int a = 0; a < c.d; ++a) {
-    double sum = 0;
-    for (const Pose& p : x) sum += std::pow(p.t(a) - x[0].t(a), 2);
-    spread = std::max(spread, sum / c.n);
-  }
+  // As the staircase calls it: with the candidate's translations from pose
+  // 0's (those optimal for its rotations) and the hint that it is probably
+  // optimal. Double cannot reach the goal here, and the one double-double
+  // factorization is all it takes (no double one); the proven shift is as
+  // sound and as tight.
   internal::VerificationOptions hinted = options;
-  hinted.translation_spread = spread;
+  hinted.translation_offsets = matrix.TranslationOffsets(
+      problem.RecoverTranslations(test_util::StackRotations(x)));
   hinted.likely_optimal = true;
-  // The translation shift a fresh matrix's first double proof starts with.
-  const double first_double_shift =
-      internal::CertificateMatrix(problem).next_double_shift();
+  // What the translation shifts a fresh matrix's first double proof starts
+  // with cost.
+  const double first_floor =
+      internal::CertificateMatrix(problem).DoubleShiftCost(
+          hinted.translation_offsets);
   // The premise (corridors kilometres long): double's floor is above the
   // goal.
-  EXPECT_GT(first_double_shift * spread, options.eta_goal / 4);
+  EXPECT_GT(first_floor, options.eta_goal / 4);
   // The verification with `o`: certified within the goal, sound, not below
   // the true shift, by one double-double proof after `factorizations`
   // double ones.
@@ -307,7 +304,7 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
     // A wrong hint (not near-optimal at 4 goal) changes the cost, not the
     // verdict.
     internal::VerificationOptions hinted_limit = limit;
-    hinted_limit.translation_spread = spread;
+    hinted_limit.translation_offsets = hinted.translation_offsets;
     hinted_limit.likely_optimal = true;
     const internal::VerificationResult h =
         internal::VerifyCertificate(problem, raised, hinted_limit, &matrix);
@@ -330,8 +327,7 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   // factorizations more.
   internal::CertificateMatrix saddle_matrix(problem);
   internal::VerificationOptions saddle = hinted;
-  saddle.eta_max =
-      std::max(options.eta_max, 8 * saddle_matrix.next_double_shift() * spread);
+  saddle.eta_max = std::max(options.eta_max, 8 * first_floor);
   const Eigen::MatrixXd raised = raise(4 * saddle.eta_max + true_shift);
   const internal::VerificationResult s =
       internal::VerifyCertificate(problem, raised, saddle, &saddle_matrix);
@@ -355,8 +351,7 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   // below tr(Lambda') / dn, where the poor-candidate test factorizes.
   internal::CertificateMatrix deep_matrix(problem);
   internal::VerificationOptions deeper = hinted;
-  deeper.eta_max =
-      std::max(options.eta_max, 0.5 * deep_matrix.next_double_shift() * spread);
+  deeper.eta_max = std::max(options.eta_max, 0.5 * first_floor);
   const double deep_delta = 40 * deeper.eta_max + true_shift;
   const Eigen::MatrixXd deep = raise(deep_delta);
   ASSERT_LT(256 * deeper.eta_max,
@@ -420,7 +415,7 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   // factorizations, and a shift within 2x of -lambda_min. Starting 10%
   // above the estimate (2.2 floors) failed there, and the ladder's next
   // shift, 8x higher, was the result (three factorizations).
-  const double floor = first_double_shift * spread;
+  const double floor = first_floor;
   const double known_delta = 2 * floor + true_shift;
   const Eigen::MatrixXd near = raise(known_delta);
   internal::VerificationOptions known = hinted;

@@ -26,10 +26,12 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/internal/sparse_cholesky_factor.h"
+#include "glog/logging.h"
 
 namespace ceres_sesync::internal {
 
@@ -65,21 +67,26 @@ class CertificateMatrix {
   // small delta, accounting for all round-off. Returns true iff it did;
   // proven_shift() is then eta.
   //
-  // The matrix factorized is K' = K_c - diag(mu I, 0), K_c assembled from
-  // the measurements' exact values and mu > 0 a shift of the translation
-  // block. A completed factorization L L^T = K'~ + E of the assembled K'~
-  // bounds, row by row, the factorization's backward error E
+  // The matrix factorized is K' = K_c - diag(M, 0), K_c assembled from the
+  // measurements' exact values and M = diag(mu_j) > 0 a shift of the
+  // translation block. A completed factorization L L^T = K'~ + E of the
+  // assembled K'~ bounds, row by row, the factorization's backward error E
   // (DoubleDoubleCholesky::RowBackwardErrorBounds, gamma_{k+1} |L||L^T| in
   // either arithmetic) and the assembly's rounding A = K'~ - K':
-  // K' + diag(rho) >= 0 with rho_i >= sum_j |E_ij| + |A_ij|. If rho_i <= mu on
-  // every translation row, then K_c + diag(0, delta I) >= 0 with delta the
-  // largest rho_i on the rotation rows, and its Schur complement gives
-  // S + (c + delta) I >= 0: a complete proof, with no first-order step. mu is
-  // adapted (per precision) until it covers the translation rows; it costs
-  // about mu x (mean squared distance of the poses from pose 0) in lambda_min,
-  // which is why large maps need double-double: its mu is ~1e15 times
-  // smaller. A double proof leaves its factor for SolveShifted() (of
-  // S_mu + cI, S_mu = S - mu Vbar^T Lbar^-2 Vbar to first order).
+  // K' + diag(rho) >= 0 with rho_i >= sum_j |E_ij| + |A_ij|. If rho_j <= mu_j
+  // on every translation row j, then K_c + diag(0, delta I) >= 0 with delta
+  // the largest rho_i on the rotation rows, and its Schur complement gives
+  // S + (c + delta) I >= 0: a complete proof, with no first-order step.
+  // The shifts are adapted until they cover their rows' bounds: in double
+  // row by row (a row's bound varies 10-1000x across rows, smallest where
+  // elimination is short), in double-double one mu for all rows. M costs
+  // about sum_j mu_j (t_j - t_0)^2 / n in lambda_min (DoubleShiftCost: the
+  // global rotations' translations, where S is near singular), which is
+  // why the largest maps need double-double: its mu is ~1e15 times smaller.
+  // Row by row, double's cost is 20-1500x below that of one mu for all rows
+  // (the largest bound) on the benchmark maps. A double proof leaves its
+  // factor for SolveShifted() (of S_M + cI, S_M = S - Vbar^T Lbar^-1 M
+  // Lbar^-1 Vbar to first order).
   bool Prove(const Eigen::MatrixXd& Lambda, double c, ProofPrecision precision);
 
   // Frees the double factor (after ExtractFactor(), its copy is all that a
@@ -87,8 +94,9 @@ class CertificateMatrix {
   // new Factorize() or double Prove() after this.
   void ReleaseFactor();
 
-  // After a successful Factorize() or double Prove(): x = (S_mu + cI)^{-1} y,
-  // y and x in R^{dn}, with mu = translation_shift() (0 after Factorize()).
+  // After a successful Factorize() or double Prove(): x = (S_M + cI)^{-1} y,
+  // y and x in R^{dn}, with M = diag(translation_shifts()) (none after
+  // Factorize()).
   void SolveShifted(const Eigen::VectorXd& y, Eigen::VectorXd* x) const;
   // The same for the columns of Y (dn x k).
   void SolveShifted(const Eigen::MatrixXd& Y, Eigen::MatrixXd* X) const;
@@ -101,10 +109,34 @@ class CertificateMatrix {
   // After a successful Prove(): eta = c + delta, delta and mu.
   double proven_shift() const { return proven_shift_; }
   double backward_error() const { return backward_error_; }
-  // mu of the current double factor (0 after Factorize()).
-  double translation_shift() const { return factorized_shift_; }
-  // The mu the next double proof starts with (adapted from the last one).
-  double next_double_shift() const { return double_shift_; }
+  // mu_j of the current double factor, by translation row j (empty after
+  // Factorize()).
+  const std::vector<double>& translation_shifts() const {
+    return factorized_shift_;
+  }
+  // mu_j the next double proof starts with, by translation row j: 64 times
+  // Lbar's row bound plus twice the data's rounding before the first proof,
+  // 1.5 times the bounds the last one met after it.
+  const std::vector<double>& next_double_shifts() const {
+    return double_shift_;
+  }
+  // Replaces them (one per translation row; for tests: the proofs adapt
+  // shifts that are too small, up to three attempts).
+  void set_next_double_shifts(std::vector<double> shifts) {
+    CHECK_EQ(static_cast<int>(shifts.size()), translation_size_);
+    double_shift_ = std::move(shifts);
+  }
+  // What those shifts cost in lambda_min(S), to first order: the largest
+  // eigenvalue of sum_j mu_j o_j o_j^T / n, o_j = offsets.col(j), offsets
+  // (d x translation_size()) the candidate's translations from the gauge's
+  // (TranslationOffsets(); none: 0). Double proofs at shifts below it fail.
+  // (One mu for all rows and the largest coordinate's sum, as before, cost
+  // 3-100x more on the benchmark maps.)
+  double DoubleShiftCost(const Eigen::MatrixXd& offsets) const;
+  // t_k - t_gauge for the translation nodes k of T (d x
+  // problem.num_translations(), RecoverTranslations()'s layout), by K's
+  // translation row.
+  Eigen::MatrixXd TranslationOffsets(const Eigen::MatrixXd& T) const;
 
   // A time limit for the factorizations (none by default): a double-double
   // factorization stops when it passes (Prove() then returns false and
@@ -152,10 +184,10 @@ class CertificateMatrix {
   SparseMatrix BaseMatrix() const;
   // base_values_, data_rounding_ and the initial shifts from `base`.
   void SetData(const SparseMatrix& base);
-  // K_ = K_c with Lambda, c and the translation block Lbar - mu I; returns
-  // per-row bounds on the rounding of this assembly.
-  void Assemble(const Eigen::MatrixXd& Lambda, double c, double mu,
-                std::vector<double>* rounding);
+  // K_ = K_c with Lambda, c and the translation block Lbar - diag(mu) (mu
+  // empty: Lbar); returns per-row bounds on the rounding of this assembly.
+  void Assemble(const Eigen::MatrixXd& Lambda, double c,
+                const std::vector<double>& mu, std::vector<double>* rounding);
   bool ProveDouble(const Eigen::MatrixXd& Lambda, double c);
   // The double factorization of K_, counted and timed; true iff it completed.
   bool FactorizeDouble();
@@ -170,7 +202,8 @@ class CertificateMatrix {
                                  std::vector<int>* permuted_row);
   // The double-double factor, sharing the double one's symbolic analysis.
   void InitializeDoubleDouble();
-  // mu settled when the translation rows' bound `head` met it or not.
+  // mu settled when the bound `head` it must cover met it or not; if not, it
+  // becomes 2 head.
   bool SettleShift(double head, double* mu) const;
 
   const SESyncProblem& problem_;
@@ -193,9 +226,12 @@ class CertificateMatrix {
   std::unique_ptr<DoubleDoubleCholesky> double_;
   bool double_factorized_ = false;
   mutable std::unique_ptr<SparseCholeskyFactor> solver_;
-  double factorized_shift_ = 0;  // mu of the current double factor.
-  // mu per precision: the translation block of a proof's matrix is Lbar - mu I.
-  double double_shift_ = 0, extended_shift_ = 0;
+  // mu_j of the current double factor (empty: none).
+  std::vector<double> factorized_shift_;
+  // The shifts the next proofs start with: the translation block of a proof's
+  // matrix is Lbar - diag(mu_j) in double, Lbar - mu I in double-double.
+  std::vector<double> double_shift_;
+  double extended_shift_ = 0;
   double proven_shift_ = 0;
   double backward_error_ = 0;
   int double_factorizations_ = 0, extended_factorizations_ = 0;

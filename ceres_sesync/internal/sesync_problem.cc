@@ -486,13 +486,11 @@ double SESyncProblem::MultiplyQCost() const {
          2.0 * (Lbar_.rows() == 0 ? 0 : lbar_solver_.stored_entries());
 }
 
-double SESyncProblem::LbarBackwardError() const {
+std::vector<double> SESyncProblem::LbarRowBackwardErrors() const {
   AwaitLbar();
-  if (Lbar_.rows() == 0) return 0;
-  double bound = 0, unused = 0;
-  lbar_factor_->BackwardErrorBound(static_cast<int>(Lbar_.rows()), &bound,
-                                   &unused);
-  return bound;
+  std::vector<double> rho;
+  if (Lbar_.rows() > 0) lbar_factor_->RowBackwardErrorBounds(&rho);
+  return rho;
 }
 
 double BlockDiagonalTrace(const Eigen::MatrixXd& Lambda, int d) {

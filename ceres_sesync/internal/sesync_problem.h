@@ -355,7 +355,7 @@ class SESyncProblem {
   // With `background_lbar` and num_threads > 1, Lbar's symbolic analysis
   // and factorization run on another thread after the constructor returns,
   // and every member that needs the factor (ok(), MultiplyQ(),
-  // RecoverTranslations(), LbarBackwardError(), LbarIsSupernodal(),
+  // RecoverTranslations(), LbarRowBackwardErrors(), LbarIsSupernodal(),
   // UpdateWeights()) waits for it: for a caller with work that needs only
   // the assembled matrices and the ordering (the chordal initialization).
   explicit SESyncProblem(const PoseGraph& graph, int num_threads = 1,
@@ -423,11 +423,11 @@ class SESyncProblem {
   // factorization's cost in solves of its factor, up to a constant, for any
   // matrix with the vertices' pattern in blocks (K, the Newton system).
   double vertex_flops_per_entry() const { return vertex_flops_per_entry_; }
-  // A bound on the backward error of Lbar's Cholesky factorization
-  // (CholmodFactor::BackwardErrorBound): the scale of the round-off that
-  // factorizations of matrices containing Lbar make in its rows. O(nnz) per
-  // call.
-  double LbarBackwardError() const;
+  // Row-wise bounds on the backward error of Lbar's Cholesky factorization
+  // (CholmodFactor::RowBackwardErrorBounds), in Lbar's row order: the scale
+  // of the round-off that factorizations of matrices containing Lbar make
+  // in its rows. O(nnz) per call.
+  std::vector<double> LbarRowBackwardErrors() const;
   // Whether CHOLMOD chose the supernodal layout for Lbar's factor (heavy
   // fill: large maps, 3D lattices).
   bool LbarIsSupernodal() const {

@@ -647,7 +647,7 @@ void Staircase::Optimize(int rank, bool escaped, bool tested,
     const double tolerance = options_.certification_max_relative_bound;
     const DescentTestPlan test = PlanDescentTest(
         Shift(0.5 * tolerance, f), Shift(0.75 * tolerance, f),
-        1.5 * certificate_->next_double_shift() * translation_spread_,
+        1.5 * certificate_->DoubleShiftCost(translation_offsets_),
         options_.proof_arithmetic);
     if (!test.run) return true;
     // Due when the products since the last test cost at least twice a
@@ -724,13 +724,6 @@ void Staircase::Optimize(int rank, bool escaped, bool tested,
 
 namespace {
 
-// max_a sum_k (t_k(a) - t_g(a))^2 / n over the translation nodes k of T
-// (d x N, gauge node g), n rotation blocks (see VerificationOptions).
-double TranslationSpread(const Eigen::MatrixXd& T, int gauge, int n) {
-  const Eigen::MatrixXd centered = T.colwise() - T.col(gauge);
-  return centered.rowwise().squaredNorm().maxCoeff() / n;
-}
-
 ProofPolicy ToPolicy(SolverOptions::ProofArithmetic arithmetic) {
   switch (arithmetic) {
     case SolverOptions::ProofArithmetic::kAutomatic:
@@ -749,11 +742,10 @@ bool Staircase::TestNearConvergence(const Eigen::MatrixXd& Y, double f,
                                     double eta, SolverSummary::Level* level) {
   // As in Verify() and VerifyCertificate's step 1.
   const double goal = Shift(options_.certification_goal_relative_bound, f);
-  translation_spread_ =
-      TranslationSpread(problem_->RecoverTranslations(RoundSolution(Y, d_)),
-                        problem_->layout().gauge(), n_);
+  translation_offsets_ = certificate_->TranslationOffsets(
+      problem_->RecoverTranslations(RoundSolution(Y, d_)));
   const double double_floor =
-      certificate_->next_double_shift() * translation_spread_;
+      certificate_->DoubleShiftCost(translation_offsets_);
   // Only where the verification goes to double-double at a sixteenth of the
   // goal's shift (double cannot reach the goal): there the threshold was
   // measured, and there a proof is dear. Where double reaches (small maps)
@@ -844,9 +836,9 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
           certificate_->factorization_flops() >= kDoubleFirstMinFlops;
     }
   }
-  translation_spread_ = TranslationSpread(problem_->RecoverTranslations(R),
-                                          problem_->layout().gauge(), n);
-  verification_options.translation_spread = translation_spread_;
+  translation_offsets_ =
+      certificate_->TranslationOffsets(problem_->RecoverTranslations(R));
+  verification_options.translation_offsets = translation_offsets_;
   VerificationResult verification = VerifyCertificate(
       *problem_, cost_->Lambda(), verification_options, certificate_.get());
   if (!verification.certified && sdp_value <= zero_objective_) {

@@ -224,9 +224,9 @@ class Staircase {
   double lower_bound_ = 0;  // Proven at the last verification.
   // The last verification skipped double-double (not exact: see Verify()).
   bool extended_deferred_ = false;
-  // The last verification's translation spread (VerificationOptions), for
+  // The last verification's translation offsets (VerificationOptions), for
   // the certificate tests' choice of arithmetic.
-  double translation_spread_ = 0;
+  Eigen::MatrixXd translation_offsets_;
   // A certificate test that passed (the optimization stopped there): its
   // Lambda, proven shift and arithmetic, for the level's verification.
   Eigen::MatrixXd passed_test_lambda_;

@@ -10,6 +10,11 @@
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
+
+// The largest double floor, in goals, from which the shifts a first double
+// proof's bounds set are expected to bring double within reach of the goal
+// (they cost 3-13x less than the first shifts on the benchmark maps).
+constexpr double kLearnedShiftReach = 2;
 namespace {
 
 // y = (S + cI)^{-1} x through the factorized K_c, for Spectra.
@@ -264,12 +269,14 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
   // 1. The fast path: a proof at the target shift, then in double one at a
   // quarter of the goal (where double suffices, e.g. compact 3D maps, that
   // is all it takes). Double proofs below the cost of their translation
-  // shift (options.translation_spread) would fail: start above it, and skip
-  // double altogether when that cost is above the goal.
+  // shift (options.translation_offsets) would fail: start above it, and
+  // skip double altogether when that cost is above the goal.
   const double double_floor =
-      matrix->next_double_shift() * options.translation_spread;
+      matrix->DoubleShiftCost(options.translation_offsets);
   VLOG(1) << "verification: double floor " << double_floor << " (target "
-          << eta_target << ", goal " << goal << ", max " << eta_max << ")";
+          << eta_target << ", goal " << goal << ", max " << eta_max
+          << "), factorization " << matrix->factorization_flops()
+          << " multiply-adds";
   // The first shift of a double ladder guided by an estimate of
   // lambda_min(S) (from a factor without translation shift): above it by
   // 10% of it, or by 1.5 double_floor where that is more. The floor is what
@@ -329,17 +336,46 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
         result.eta <= goal) {
       return finish();
     }
-  } else if (options.likely_optimal && !options.test_in_double_first) {
-    // Double cannot reach the goal; a probably optimal candidate goes to
-    // double-double directly (see VerificationOptions::likely_optimal).
-    if (attempt(goal / 16) && result.eta <= goal) return finish();
-    // Failed: lambda_min(S) < -goal / 16. Usually a lifted saddle of rank
-    // d (rounding loses nothing there either), whose witness step 4 finds:
-    // the near-optimality test of step 2 is skipped. A near-optimal
-    // candidate is recognized after step 4 instead, by the witness's
-    // curvature, and its double-double proofs then step up by 8 from the
-    // goal (without step 2's Lanczos estimate).
-    suspect_saddle = !(result.eta <= eta_max);
+  } else {
+    // Double cannot reach the goal with the shifts its next proof starts
+    // with. A fresh matrix's come from Lbar's round-off (3-13x above the
+    // bounds K's own factorization then has, weighted by what they cost);
+    // a completed proof sets the next ones from its bounds. Where that is
+    // expected to bring double within reach (a floor within
+    // kLearnedShiftReach goals) and a double-double factorization costs
+    // well over two double ones (learned_shift_min_multiply_adds), a double
+    // proof at what the first shifts cost, then one at what its bounds cost
+    // (if that and the first's rotation rows' bound are within half the
+    // goal), come before double-double. Either ends the verification
+    // within half the goal; above it double-double tightens as before.
+    if (double_floor <= kLearnedShiftReach * goal &&
+        matrix->factorization_flops() >=
+            options.learned_shift_min_multiply_adds &&
+        !options.test_in_double_first) {
+      const double c1 = std::max(eta_target, 1.5 * double_floor);
+      if (prove(c1, ProofPrecision::kDouble)) {
+        if (result.eta <= goal / 2) return finish();
+        const double c2 = std::max(
+            eta_target,
+            1.5 * matrix->DoubleShiftCost(options.translation_offsets));
+        if (c2 + matrix->backward_error() <= goal / 2 &&
+            prove(c2, ProofPrecision::kDouble) && result.eta <= goal / 2) {
+          return finish();
+        }
+      }
+    }
+    if (options.likely_optimal && !options.test_in_double_first) {
+      // A probably optimal candidate goes to double-double directly (see
+      // VerificationOptions::likely_optimal).
+      if (attempt(goal / 16) && result.eta <= goal) return finish();
+      // Failed: lambda_min(S) < -goal / 16. Usually a lifted saddle of rank
+      // d (rounding loses nothing there either), whose witness step 4
+      // finds: the near-optimality test of step 2 is skipped. A
+      // near-optimal candidate is recognized after step 4 instead, by the
+      // witness's curvature, and its double-double proofs then step up by 8
+      // from the goal (without step 2's Lanczos estimate).
+      suspect_saddle = !(result.eta <= eta_max);
+    }
   }
 
   // 2. Near-optimal (lambda_min(S) > -eta_max up to round-off) or not?

@@ -29,16 +29,23 @@ struct VerificationOptions {
   // <= 0: the goal is out of reach, use eta_max.
   double eta_goal = 0;
   ProofPolicy policy = ProofPolicy::kAutomatic;
-  // max over coordinates a of sum_i (t_i(a) - t_0(a))^2 / n for the
-  // candidate's translations (0: unknown). A double proof lowers the
-  // translation block by mu, which costs about mu times this in
+  // kAutomatic where double cannot reach the goal with the shifts its next
+  // proof starts with, but within kLearnedShiftReach goals: two double
+  // proofs (the second with the first's bounds as shifts) are tried before
+  // double-double on factorizations of at least this many multiply-adds
+  // (below it a double-double factorization costs about two double ones).
+  double learned_shift_min_multiply_adds = 1e7;
+  // The candidate's translations from the gauge's, by K's translation row
+  // (CertificateMatrix::TranslationOffsets; empty: unknown). A double proof
+  // lowers the translation block by diag(mu_j), which costs about
+  // CertificateMatrix::DoubleShiftCost(translation_offsets) in
   // lambda_min(S) (the global-rotation directions, where S is near
   // singular): shifts below that are not tried in double.
-  double translation_spread = 0;
+  Eigen::MatrixXd translation_offsets;
   // The candidate is probably optimal (the caller's evidence: the staircase
   // sets it when rounding Y loses at most the goal; a lifted saddle of rank
   // d passes that test too). Where double cannot reach the goal (its floor,
-  // see translation_spread, is above it) and kAutomatic escalates to
+  // see translation_offsets, is above it) and kAutomatic escalates to
   // double-double, the double-double proof at goal / 16 is then tried first,
   // before the near-optimality test in double (one double factorization at
   // eta_max), which is needed only if that proof fails: a certified map
