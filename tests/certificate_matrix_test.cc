@@ -484,6 +484,39 @@ TEST_F(CertificateTest, VerificationStopsAtItsDeadline) {
   EXPECT_TRUE(on_time.certified);
 }
 
+// A square grid (pose 0 at a corner, `side` poses a side, kappa = tau =
+// `precision`) solved to its certified optimum, and the multipliers at the
+// solution's rotations, as Certify computes them.
+struct SolvedGrid {
+  PoseGraph graph;
+  std::unique_ptr<SESyncProblem> problem;
+  MatrixXd R, Lambda;
+  double f = 0;
+};
+void SolveGrid(int side, double precision, uint64_t seed, double p_lc,
+               SolvedGrid* grid) {
+  CubeOptions o;
+  o.dimension = 2;
+  o.side = side;
+  o.kappa = o.tau = precision;
+  o.seed = seed;
+  o.loop_closure_probability = p_lc;
+  std::string error;
+  ASSERT_TRUE(GenerateCube(o, &grid->graph, nullptr, &error)) << error;
+  SolverOptions options;
+  options.num_threads = 1;
+  SolverSummary summary;
+  const Poses x = Solve(grid->graph, options, &summary);
+  ASSERT_TRUE(summary.certified()) << summary.FullReport();
+  grid->problem = std::make_unique<SESyncProblem>(grid->graph);
+  ASSERT_TRUE(grid->problem->ok());
+  SESyncPreconditioner none(*grid->problem, PreconditionerType::kNone, 1e6);
+  SESyncCost cost(grid->problem.get(), &none);
+  grid->R = test_util::StackRotations(x);
+  grid->f = cost.Evaluate(grid->R);
+  grid->Lambda = cost.Lambda();
+}
+
 // DoubleShiftCost is the first-order change of lambda_min(S) that the
 // double proofs' translation shifts cause. At a square grid's certified
 // optimum (S >= 0, its null space the rows of R), Lbar lowered by sigma
@@ -493,28 +526,12 @@ TEST_F(CertificateTest, VerificationStopsAtItsDeadline) {
 // eigenvalue of sum_j mu_j o_j o_j^T / n) is well above either coordinate's
 // sum alone.
 TEST(CertificateMatrixShifts, DoubleShiftCostIsTheFirstOrderChange) {
-  CubeOptions o;
-  o.dimension = 2;
-  o.side = 8;
-  o.kappa = 100;
-  o.tau = 100;
-  o.seed = 3;
-  o.loop_closure_probability = 0.3;
-  PoseGraph graph;
-  std::string error;
-  ASSERT_TRUE(GenerateCube(o, &graph, nullptr, &error)) << error;
-  SolverOptions options;
-  options.num_threads = 1;
-  SolverSummary summary;
-  const Poses x = Solve(graph, options, &summary);
-  ASSERT_TRUE(summary.certified()) << summary.FullReport();
-  SESyncProblem problem(graph);
-  ASSERT_TRUE(problem.ok());
-  SESyncPreconditioner none(problem, PreconditionerType::kNone, 1e6);
-  SESyncCost cost(&problem, &none);
-  const MatrixXd R = test_util::StackRotations(x);
-  cost.Evaluate(R);
-  const MatrixXd Lambda = cost.Lambda();
+  SolvedGrid grid;
+  SolveGrid(8, 100, 3, 0.3, &grid);
+  const PoseGraph& graph = grid.graph;
+  const SESyncProblem& problem = *grid.problem;
+  const MatrixXd& R = grid.R;
+  const MatrixXd& Lambda = grid.Lambda;
   CertificateMatrix matrix(problem);
   const MatrixXd offsets =
       matrix.TranslationOffsets(problem.RecoverTranslations(R));
@@ -566,30 +583,13 @@ TEST(CertificateMatrixShifts, DoubleShiftCostIsTheFirstOrderChange) {
 // tree carry more round-off), and a proof at the same c from the next
 // shifts uses them unchanged.
 TEST(CertificateMatrixShifts, EveryTranslationRowIsCoveredByItsShift) {
-  CubeOptions o;
-  o.dimension = 2;
-  o.side = 8;
-  o.kappa = 100;
-  o.tau = 100;
-  o.seed = 3;
-  o.loop_closure_probability = 0.3;
-  PoseGraph graph;
-  std::string error;
-  ASSERT_TRUE(GenerateCube(o, &graph, nullptr, &error)) << error;
-  SolverOptions options;
-  options.num_threads = 1;
-  SolverSummary summary;
-  const Poses x = Solve(graph, options, &summary);
-  ASSERT_TRUE(summary.certified()) << summary.FullReport();
-  SESyncProblem problem(graph);
-  ASSERT_TRUE(problem.ok());
-  SESyncPreconditioner none(problem, PreconditionerType::kNone, 1e6);
-  SESyncCost cost(&problem, &none);
-  cost.Evaluate(test_util::StackRotations(x));
-  const MatrixXd Lambda = cost.Lambda();
+  SolvedGrid grid;
+  SolveGrid(8, 100, 3, 0.3, &grid);
+  const SESyncProblem& problem = *grid.problem;
+  const MatrixXd& Lambda = grid.Lambda;
   CertificateMatrix matrix(problem);
-  const int n1 = graph.num_poses - 1;
-  const double c = 1e-6 * cost.Evaluate(test_util::StackRotations(x));
+  const int n1 = grid.graph.num_poses - 1;
+  const double c = 1e-6 * grid.f;
   matrix.set_next_double_shifts(std::vector<double>(n1, 1e-300));
   const int before = matrix.double_factorizations();
   ASSERT_TRUE(matrix.Prove(Lambda, c, internal::ProofPrecision::kDouble));
@@ -618,28 +618,13 @@ TEST(CertificateMatrixShifts, EveryTranslationRowIsCoveredByItsShift) {
 // the dense lambda_min(S), and within half the goal. Below that size (the
 // default's 1e7 here) one double-double proof, as before.
 TEST(CertificateMatrixShifts, LearnedShiftsProveTheGoalInDouble) {
-  CubeOptions o;
-  o.dimension = 2;
-  o.side = 16;
-  o.kappa = 3e3;
-  o.tau = 3e3;
-  o.seed = 1;
-  o.loop_closure_probability = 0.1;
-  PoseGraph graph;
-  std::string error;
-  ASSERT_TRUE(GenerateCube(o, &graph, nullptr, &error)) << error;
-  SolverOptions solver_options;
-  solver_options.num_threads = 1;
-  SolverSummary summary;
-  const Poses x = Solve(graph, solver_options, &summary);
-  ASSERT_TRUE(summary.certified()) << summary.FullReport();
-  SESyncProblem problem(graph);
-  ASSERT_TRUE(problem.ok());
-  SESyncPreconditioner none(problem, PreconditionerType::kNone, 1e6);
-  SESyncCost cost(&problem, &none);
-  const MatrixXd R = test_util::StackRotations(x);
-  const double f = cost.Evaluate(R);
-  const MatrixXd Lambda = cost.Lambda();
+  SolvedGrid grid;
+  SolveGrid(16, 3e3, 1, 0.1, &grid);
+  const PoseGraph& graph = grid.graph;
+  const SESyncProblem& problem = *grid.problem;
+  const MatrixXd& R = grid.R;
+  const MatrixXd& Lambda = grid.Lambda;
+  const double f = grid.f;
   const int dn = 2 * graph.num_poses;
   internal::VerificationOptions options;
   options.eta_target = 1e-9 * f / dn;
