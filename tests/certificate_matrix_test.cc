@@ -528,16 +528,12 @@ void SolveGrid(int side, double precision, uint64_t seed, double p_lc,
 TEST(CertificateMatrixShifts, DoubleShiftCostIsTheFirstOrderChange) {
   SolvedGrid grid;
   SolveGrid(8, 100, 3, 0.3, &grid);
-  const PoseGraph& graph = grid.graph;
-  const SESyncProblem& problem = *grid.problem;
-  const MatrixXd& R = grid.R;
-  const MatrixXd& Lambda = grid.Lambda;
-  CertificateMatrix matrix(problem);
+  CertificateMatrix matrix(*grid.problem);
   const MatrixXd offsets =
-      matrix.TranslationOffsets(problem.RecoverTranslations(R));
+      matrix.TranslationOffsets(grid.problem->RecoverTranslations(grid.R));
   const double model = matrix.DoubleShiftCost(offsets);
   const std::vector<double>& mu = matrix.next_double_shifts();
-  const int n1 = static_cast<int>(offsets.cols()), n = graph.num_poses;
+  const int n1 = static_cast<int>(offsets.cols()), n = grid.graph.num_poses;
   ASSERT_EQ(static_cast<int>(mu.size()), n1);
   VectorXd shift(n1);
   double largest_coordinate = 0;
@@ -550,8 +546,8 @@ TEST(CertificateMatrixShifts, DoubleShiftCostIsTheFirstOrderChange) {
   EXPECT_GT(model, 1.3 * largest_coordinate);  // The premise: a corner.
 
   const test_util::DenseLandmarkProblem blocks =
-      test_util::BuildDenseLandmarkProblem(graph);
-  const MatrixXd LambdaDense = test_util::BlockDiagonalToDense(Lambda, 2);
+      test_util::BuildDenseLandmarkProblem(grid.graph);
+  const MatrixXd LambdaDense = test_util::BlockDiagonalToDense(grid.Lambda, 2);
   auto lambda_min = [&](double sigma) {
     const MatrixXd Lbar = blocks.Lbar - sigma * MatrixXd(shift.asDiagonal());
     const MatrixXd S = blocks.D -
@@ -620,20 +616,15 @@ TEST(CertificateMatrixShifts, EveryTranslationRowIsCoveredByItsShift) {
 TEST(CertificateMatrixShifts, LearnedShiftsProveTheGoalInDouble) {
   SolvedGrid grid;
   SolveGrid(16, 3e3, 1, 0.1, &grid);
-  const PoseGraph& graph = grid.graph;
-  const SESyncProblem& problem = *grid.problem;
-  const MatrixXd& R = grid.R;
-  const MatrixXd& Lambda = grid.Lambda;
-  const double f = grid.f;
-  const int dn = 2 * graph.num_poses;
+  const int dn = 2 * grid.graph.num_poses;
   internal::VerificationOptions options;
-  options.eta_target = 1e-9 * f / dn;
-  options.eta_goal = 1e-6 * f / dn;
-  options.eta_max = 1e-3 * f / dn;
+  options.eta_target = 1e-9 * grid.f / dn;
+  options.eta_goal = 1e-6 * grid.f / dn;
+  options.eta_max = 1e-3 * grid.f / dn;
   options.likely_optimal = true;
-  CertificateMatrix fresh(problem);
+  CertificateMatrix fresh(*grid.problem);
   options.translation_offsets =
-      fresh.TranslationOffsets(problem.RecoverTranslations(R));
+      fresh.TranslationOffsets(grid.problem->RecoverTranslations(grid.R));
   // The premise: double's floor with a fresh matrix's shifts is above a
   // quarter of the goal (no double proof first) and within the reach.
   const double floor = fresh.DoubleShiftCost(options.translation_offsets);
@@ -642,22 +633,22 @@ TEST(CertificateMatrixShifts, LearnedShiftsProveTheGoalInDouble) {
   ASSERT_LT(fresh.factorization_flops(),
             options.learned_shift_min_multiply_adds);
 
-  const MatrixXd S =
-      test_util::DenseQ(graph) - test_util::BlockDiagonalToDense(Lambda, 2);
+  const MatrixXd S = test_util::DenseQ(grid.graph) -
+                     test_util::BlockDiagonalToDense(grid.Lambda, 2);
   const double lambda_min =
       Eigen::SelfAdjointEigenSolver<MatrixXd>(S, Eigen::EigenvaluesOnly)
           .eigenvalues()(0);
 
   const VerificationResult small =
-      internal::VerifyCertificate(problem, Lambda, options, &fresh);
+      internal::VerifyCertificate(*grid.problem, grid.Lambda, options, &fresh);
   ASSERT_TRUE(small.certified);
   EXPECT_EQ(small.factorizations, 0);
   EXPECT_EQ(small.extended_factorizations, 1);
 
   options.learned_shift_min_multiply_adds = 0;
-  CertificateMatrix matrix(problem);
+  CertificateMatrix matrix(*grid.problem);
   const VerificationResult v =
-      internal::VerifyCertificate(problem, Lambda, options, &matrix);
+      internal::VerifyCertificate(*grid.problem, grid.Lambda, options, &matrix);
   ASSERT_TRUE(v.certified);
   EXPECT_EQ(v.precision, internal::ProofPrecision::kDouble);
   EXPECT_EQ(v.extended_factorizations, 0);
