@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include "Eigen/Eigenvalues"
 #include "ceres_sesync/internal/double_double.h"
@@ -353,29 +354,34 @@ bool CertificateMatrix::ProveDouble(const Eigen::MatrixXd& Lambda, double c) {
     Assemble(Lambda, c, factorized_shift_, &rounding);
     if (!FactorizeDouble()) return false;
     double_->RowBackwardErrorBounds(&rho);
+    // Row i's bound, in K's order (overwriting rounding).
+    std::vector<double>& bound = rounding;
+    for (int i = 0; i < static_cast<int>(bound.size()); ++i) {
+      bound[i] += rho[position_[i]] + data_rounding_[i];
+    }
     // Row j of the translation block settles when its bound is within its
     // shift mu_j; a row that does not gets twice its bound next time.
-    double head = 0, tail = 0, largest_shift = 0;
     bool settled = true;
-    for (int i = 0; i < static_cast<int>(rho.size()); ++i) {
-      const double bound = rho[position_[i]] + rounding[i] + data_rounding_[i];
-      if (i < t0) {
-        head = std::max(head, bound);
-        largest_shift = std::max(largest_shift, factorized_shift_[i]);
-        settled = SettleShift(bound, &double_shift_[i]) && settled;
-      } else {
-        tail = std::max(tail, bound);
-      }
+    for (int j = 0; j < t0; ++j) {
+      settled = SettleShift(bound[j], &double_shift_[j]) && settled;
     }
     if (settled) {
+      // The largest of a range of nonnegative values (0 if it is empty).
+      auto largest = [](auto first, auto last) {
+        return std::accumulate(first, last, 0.0, [](double a, double b) {
+          return std::max(a, b);
+        });
+      };
+      const double head = largest(bound.begin(), bound.begin() + t0);
+      const double tail = largest(bound.begin() + t0, bound.end());
+      const double largest_shift =
+          largest(factorized_shift_.begin(), factorized_shift_.end());
       backward_error_ = tail;
       proven_shift_ = c + tail;
       // Next time start closer to what this one needed, row by row.
-      for (int i = 0; i < t0; ++i) {
-        const double bound =
-            rho[position_[i]] + rounding[i] + data_rounding_[i];
-        double_shift_[i] =
-            std::max(1.5 * bound, std::numeric_limits<double>::min());
+      for (int j = 0; j < t0; ++j) {
+        double_shift_[j] =
+            std::max(1.5 * bound[j], std::numeric_limits<double>::min());
       }
       VLOG(1) << "K_c proven (double): c " << c << " backward error " << tail
               << " (translation rows " << head << ", largest shift "

@@ -142,17 +142,6 @@ void CholmodFactor::RowBackwardErrorBounds(std::vector<double>* rho) {
   }
 }
 
-void CholmodFactor::BackwardErrorBound(int split, double* head_bound,
-                                       double* tail_bound) {
-  std::vector<double> rho;
-  RowBackwardErrorBounds(&rho);
-  *head_bound = *tail_bound = 0;
-  for (int i = 0; i < static_cast<int>(rho.size()); ++i) {
-    double& side = i < split ? *head_bound : *tail_bound;
-    side = std::max(side, rho[i]);
-  }
-}
-
 SparseCholeskyFactor CholmodFactor::ExtractFactor() {
   return SparseCholeskyFactor(m_cholmodFactor, &cholmod());
 }

@@ -118,10 +118,8 @@ class CholmodFactor : public CholmodDecompositionWithOrdering<SparseMatrix> {
   // bound holds for every order of summation (Higham Lemma 8.4), so blocked
   // supernodal kernels need no widening; and
   // -E <= diag(rho) for rho_i = sum_j |E_ij| (symmetric E, Gershgorin-type:
-  // 2 |x_i x_j| <= x_i^2 + x_j^2). O(nnz(L)), on the factor in place.
-  void BackwardErrorBound(int split, double* head_bound, double* tail_bound);
-  // The same bound row by row: rho[i] >= sum_j |E_ij| for every original
-  // index i.
+  // 2 |x_i x_j| <= x_i^2 + x_j^2). Row by row: rho[i] >= sum_j |E_ij| for
+  // every original index i. O(nnz(L)), on the factor in place.
   void RowBackwardErrorBounds(std::vector<double>* rho);
   // After a successful factorization: a copy of the factor for fast solves
   // with r x N right-hand sides.

@@ -10,12 +10,12 @@
 #include "glog/logging.h"
 
 namespace ceres_sesync::internal {
+namespace {
 
 // The largest double floor, in goals, from which the shifts a first double
 // proof's bounds set are expected to bring double within reach of the goal
 // (they cost 3-13x less than the first shifts on the benchmark maps).
 constexpr double kLearnedShiftReach = 2;
-namespace {
 
 // y = (S + cI)^{-1} x through the factorized K_c, for Spectra.
 class ShiftInvertOperator {
