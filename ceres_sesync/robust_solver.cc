@@ -619,7 +619,9 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       if (!problem.SetWeights(binary, &message)) return false;
       *Y_io = ReduceRank(*Y_io, d, r0, kRankTolerance);
       problem.staircase().Run(Y_io);
-      *poses = problem.staircase().Round(*Y_io).poses;
+      Solution x = problem.staircase().Round(*Y_io);
+      problem.staircase().Continue(Y_io, &x);
+      *poses = std::move(x.poses);
       reported = false;
       return true;
     };

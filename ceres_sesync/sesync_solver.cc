@@ -8,7 +8,8 @@
 namespace ceres_sesync {
 namespace {
 
-// problem -> initialize -> staircase -> round -> report (internal/staircase.h).
+// problem -> initialize -> staircase -> round -> continue -> report
+// (internal/staircase.h).
 Solution SolveImpl(const PoseGraph& graph, const Poses* initial,
                    const SolverOptions& options, SolverSummary* summary) {
   internal::Staircase staircase(graph, options, summary);
@@ -23,6 +24,7 @@ Solution SolveImpl(const PoseGraph& graph, const Poses* initial,
   if (!staircase.Initialize(initial, &Y)) return {};
   staircase.Run(&Y);
   Solution solution = staircase.Round(Y);
+  staircase.Continue(&Y, &solution);
   staircase.Report(Y, solution);
   return solution;
 }

@@ -266,7 +266,15 @@ struct SolverSummary {
     kCertifiedOptimum,
     // A lower bound was proven, but the poses' relative suboptimality bound
     // is above certification_max_relative_bound (e.g. a relaxation that is
-    // not exact here: see relaxation_exact). lower_bound is valid.
+    // not exact here: see relaxation_exact). lower_bound is valid. Where the
+    // relaxation was certified within the tolerance but the rounded poses
+    // were not, and a tighter proof could have brought them within (F(Y)
+    // above the lower bound they need), the staircase has tried it first:
+    // Y verified again at the shift that bound allows, then escapes and
+    // levels towards it (a level "verified again for the rounded poses" in
+    // `levels`); this status means it failed (the relaxation's optimum is
+    // below that bound, or max_rank or the time limit stopped it), and the
+    // poses and bound are those from before.
     kBoundAboveTolerance,
     kSaddleNotEscaped,  // Negative curvature found, no descent along it.
     kEigenImprecision,  // No shift proven and no negative curvature found.

@@ -511,6 +511,14 @@ double Staircase::Shift(double relative_bound, double sdp_value) const {
                   relative_bound * sdp_value / (static_cast<double>(d_) * n_));
 }
 
+double Staircase::MaxShift(double fraction, double sdp_value) const {
+  const double shift =
+      Shift(fraction * options_.certification_max_relative_bound, sdp_value);
+  if (!(required_lower_bound_ > 0)) return shift;
+  return std::min(shift, fraction * (sdp_value - required_lower_bound_) /
+                             (static_cast<double>(d_) * n_));
+}
+
 bool Staircase::TestCertificate(double eta, ProofPrecision precision,
                                 bool tighten, SolverSummary::Level* level) {
   const Clock::time_point deadline = Deadline();
@@ -644,9 +652,11 @@ void Staircase::Optimize(int rank, bool escaped, bool tested,
     }
     if (!test_during) return true;
     level_products += products;
-    const double tolerance = options_.certification_max_relative_bound;
+    const double half_shift = MaxShift(0.5, f);
+    // Continue(): F(Y) at or below the bound it needs, no test can prove it.
+    if (!(half_shift > 0)) return true;
     const DescentTestPlan test = PlanDescentTest(
-        Shift(0.5 * tolerance, f), Shift(0.75 * tolerance, f),
+        half_shift, MaxShift(0.75, f),
         1.5 * certificate_->DoubleShiftCost(translation_offsets_),
         options_.proof_arithmetic);
     if (!test.run) return true;
@@ -772,10 +782,12 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
   VerificationOptions verification_options;
   verification_options.eta_target =
       Shift(options_.certification_target_relative_bound, sdp_value);
-  verification_options.eta_max =
-      Shift(options_.certification_max_relative_bound, sdp_value);
+  verification_options.eta_max = MaxShift(1, sdp_value);
   verification_options.eta_goal =
-      Shift(options_.certification_goal_relative_bound, sdp_value);
+      std::min(verification_options.eta_max,
+               Shift(options_.certification_goal_relative_bound, sdp_value));
+  verification_options.eta_target =
+      std::min(verification_options.eta_target, verification_options.eta_goal);
   verification_options.policy = ToPolicy(options_.proof_arithmetic);
   verification_options.deadline = Deadline();
   // Below the maximum rank a failed certificate is escaped from, and the
@@ -871,9 +883,14 @@ bool Staircase::Escape(const Eigen::MatrixXd& Y, Eigen::MatrixXd* Y_plus) {
 
 void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
   AwaitSetup();
-  SolverSummary& s = *summary_;
   escaped_rounding_.resize(0, 0);
   escaped_rounding_value_ = std::numeric_limits<double>::infinity();
+  Climb(Y, verify_at_max_rank, /*verify_first=*/false);
+}
+
+void Staircase::Climb(Eigen::MatrixXd* Y, bool verify_at_max_rank,
+                      bool verify_first) {
+  SolverSummary& s = *summary_;
   for (int r = static_cast<int>(Y->rows()), first = r;; ++r) {
     SolverSummary::Level level;
     level.rank = r;
@@ -881,20 +898,29 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
     // Tests on the way only after an escape, and only where the level's
     // certificate is tested at all.
     const bool tested = verify_at_max_rank || r < options_.max_rank;
-    // kAutomatic's block-Jacobi ends at a saddle escape: the descent after
-    // one is long and flat (hundreds of products), where the exact
-    // preconditioner pays for its factorization.
-    if (r > first) preconditioner_->SwitchToExact();
-    Optimize(r, /*escaped=*/r > first, tested, Y, &level);
-    // Without the certificate tests' time (verify_time_s so far).
-    level.optimize_time_s =
-        std::chrono::duration<double>(Clock::now() - t).count() -
-        level.verify_time_s;
+    if (verify_first && r == first) {
+      level.termination = "verified again for the rounded poses";
+      cost_->Evaluate(*Y);  // Lambda at Y (rounding moved the cost).
+    } else {
+      // kAutomatic's block-Jacobi ends at a saddle escape: the descent
+      // after one is long and flat (hundreds of products), where the exact
+      // preconditioner pays for its factorization.
+      if (r > first) preconditioner_->SwitchToExact();
+      Optimize(r, /*escaped=*/r > first, tested, Y, &level);
+      // Without the certificate tests' time (verify_time_s so far).
+      level.optimize_time_s =
+          std::chrono::duration<double>(Clock::now() - t).count() -
+          level.verify_time_s;
+    }
     // F(Y) = tr(Q Y^T Y) = tr(Lambda): the dual objective of these multipliers.
     sdp_value_ = BlockDiagonalTrace(cost_->Lambda(), d_);
     level.sdp_value = sdp_value_;
+    // F(Y) bounds the relaxation's optimum from above: at or below the
+    // bound Continue() needs, no certificate of it reaches that bound.
+    const bool out_of_reach =
+        required_lower_bound_ > 0 && !(sdp_value_ > required_lower_bound_);
 
-    if (tested) {
+    if (tested && !out_of_reach) {
       Progress("verify", r, level.iterations, sdp_value_, level.gradient_norm);
       t = Clock::now();
       verification_ = Verify(*Y, sdp_value_);
@@ -945,6 +971,10 @@ void Staircase::Run(Eigen::MatrixXd* Y, bool verify_at_max_rank) {
                 << verification_.eta << ", lambda_min estimate "
                 << verification_.lambda_min_estimate
                 << (verification_.certified ? " (certified)" : "");
+    }
+    if (out_of_reach) {
+      s.status = SolverSummary::Status::kBoundAboveTolerance;
+      return;
     }
     if (!tested) {  // At max_rank: nothing to escape to.
       s.status = SolverSummary::Status::kMaxRankReached;
@@ -1058,6 +1088,62 @@ Solution Staircase::Round(const Eigen::MatrixXd& Y) {
   Solution solution = ToSolutionInGauge(graph_, R, T);
   s.rounding_time_s = std::chrono::duration<double>(Clock::now() - t).count();
   return solution;
+}
+
+bool Staircase::Continue(Eigen::MatrixXd* Y, Solution* solution) {
+  AwaitSetup();
+  SolverSummary& s = *summary_;
+  if (s.status != SolverSummary::Status::kCertifiedOptimum ||
+      !(lower_bound_ > 0) ||
+      (options_.max_time_s > 0 && Elapsed() >= options_.max_time_s)) {
+    return false;
+  }
+  const double tol = options_.certification_max_relative_bound;
+  const double upper =
+      ObjectiveUpperBound(graph_, *solution, problem_->weights());
+  if (upper - lower_bound_ <= tol * lower_bound_) return false;
+  // The lower bound that puts the solution within the tolerance, with 1% of
+  // it to spare (Report() evaluates F again). F(Y) is an upper bound on
+  // the relaxation's optimum: at or below it, the relaxation's own gap
+  // misses the tolerance.
+  const double needed = upper / (1 + 0.99 * tol);
+  if (!(needed < sdp_value_)) return false;
+  // What Report() reads, restored if the bound is not reached.
+  const Eigen::MatrixXd Y_before = *Y;
+  const VerificationResult verification_before = verification_;
+  const double sdp_value_before = sdp_value_, lower_bound_before = lower_bound_;
+  const bool extended_deferred_before = extended_deferred_;
+  const int final_rank_before = s.final_rank;
+  if (options_.verbose) {
+    LOG(INFO) << "continuing: F(x) " << upper << " needs a lower bound of "
+              << needed << " (proven " << lower_bound_ << ", F(Y) "
+              << sdp_value_ << ")";
+  }
+  required_lower_bound_ = needed;
+  Climb(Y, /*verify_at_max_rank=*/true, /*verify_first=*/true);
+  required_lower_bound_ = 0;
+  if (s.status == SolverSummary::Status::kCertifiedOptimum &&
+      lower_bound_ >= needed) {
+    const double first_rounding_s = s.rounding_time_s;
+    Solution again = Round(*Y);
+    s.rounding_time_s += first_rounding_s;
+    auto objective = [&](const Solution& x) {
+      return problem_->weights().empty()
+                 ? EvaluateObjective(graph_, x)
+                 : WeightedObjective(graph_, problem_->weights(), x.poses);
+    };
+    if (objective(again) < objective(*solution)) *solution = std::move(again);
+    return true;
+  }
+  *Y = Y_before;
+  verification_ = verification_before;
+  sdp_value_ = sdp_value_before;
+  lower_bound_ = lower_bound_before;
+  extended_deferred_ = extended_deferred_before;
+  s.final_rank = final_rank_before;
+  s.status = SolverSummary::Status::kCertifiedOptimum;
+  cost_->Evaluate(*Y);
+  return false;
 }
 
 void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {

@@ -13,6 +13,7 @@
 //   staircase.Run(&Y);                               // optimize / verify /
 //                                                    // escape, level by level
 //   Solution x = staircase.Round(Y);                 // Algorithm 2 + eq. (21)
+//   staircase.Continue(&Y, &x);                      // the bound x needs
 //   staircase.Report(Y, x);                          // objective, bounds,
 //                                                    // status
 //
@@ -120,6 +121,20 @@ class Staircase {
   // bound, Y's rounding is refined as well and the lower of the two kept.
   Solution Round(const Eigen::MatrixXd& Y);
 
+  // Stage "continue", after round: where the relaxation was certified but
+  // the rounded `solution` is not within the tolerance of the proven bound,
+  // and a bound the relaxation can still give would bring it within (F(Y),
+  // which bounds the relaxation's optimum from above, is above the lower
+  // bound the solution needs: the proof's slack eta d n, not the
+  // relaxation's gap, is what misses), the staircase goes on from Y with
+  // that lower bound as its target: Y's verification again at the shift it
+  // allows, then escapes and levels as in Run() (their certificate tests
+  // aim at it too). True iff it proved that bound; *solution is then the
+  // lower-objective of it and the new Y's rounding. Otherwise Y, the
+  // verification and the status are restored (the levels it ran stay in
+  // the summary) and false is returned; also where there was nothing to do.
+  bool Continue(Eigen::MatrixXd* Y, Solution* solution);
+
   // Stage "report": objective, lower bound, suboptimality bounds, rounding
   // gap, final status and total time for the returned `solution` (rounded
   // from Y). When the relaxation proved not exact and double precision left
@@ -163,6 +178,14 @@ class Staircase {
   // The shift of a relative bound on the objective: relative_bound *
   // sdp_value / (d n), at least min_relative_eta's floor.
   double Shift(double relative_bound, double sdp_value) const;
+  // The shift a certificate at F(Y) = sdp_value may have, scaled by
+  // `fraction`: that of the tolerance (certification_max_relative_bound),
+  // and while Continue() runs at most `fraction` of the shift that proves
+  // required_lower_bound_ (not positive where F(Y) is not above it).
+  double MaxShift(double fraction, double sdp_value) const;
+  // Run()'s levels from Y; with `verify_first`, the first level (Y's own)
+  // is verified again without optimizing (Continue()).
+  void Climb(Eigen::MatrixXd* Y, bool verify_at_max_rank, bool verify_first);
   // One certificate test at the current point of the cost: tries to prove
   // S + eta I >= 0 (not started if predicted to end after the time limit).
   // Adds its factorizations to `level`; true iff it proved it. A passed
@@ -222,6 +245,8 @@ class Staircase {
   double escaped_rounding_value_ = std::numeric_limits<double>::infinity();
   double sdp_value_ = 0;
   double lower_bound_ = 0;  // Proven at the last verification.
+  // The lower bound Continue() aims at (0: none, the tolerance alone).
+  double required_lower_bound_ = 0;
   // The last verification skipped double-double (not exact: see Verify()).
   bool extended_deferred_ = false;
   // The last verification's translation offsets (VerificationOptions), for
