@@ -438,6 +438,47 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
   EXPECT_EQ(reference.NegativePivots(near, k.eta), 0)
       << "FALSE CERTIFICATE at eta " << k.eta;
 
+  // The same with the test's double factor still held (the staircase keeps
+  // a passed double test's factor: known_shift_factor). Its Lanczos
+  // estimate is of S'_M, the test's translation shifts M costing about a
+  // floor: where lambda_min(S') is far below that (-40 floors), the
+  // estimate is used and the factorization at the known shift saved, with
+  // the same kind of tightened shift; near it (-2 floors, as above) the
+  // estimate would start the proofs too high, and a factor at the known
+  // shift is made after all (as many factorizations, as tight a shift).
+  auto verify_held = [&](const Eigen::MatrixXd& lambda, double delta,
+                         internal::VerificationResult* fresh) {
+    internal::VerificationOptions o = known;
+    o.known_shift = 64 * delta;
+    {
+      internal::CertificateMatrix matrix(problem);
+      *fresh = internal::VerifyCertificate(problem, lambda, o, &matrix);
+    }
+    internal::CertificateMatrix matrix(problem);
+    EXPECT_TRUE(matrix.Prove(lambda, o.known_shift,
+                             internal::ProofPrecision::kDouble));
+    o.known_shift_factor = o.known_shift;
+    o.known_shift = matrix.proven_shift();
+    return internal::VerifyCertificate(problem, lambda, o, &matrix);
+  };
+  for (const double delta : {40 * floor + true_shift, known_delta}) {
+    SCOPED_TRACE("lambda_min(S') = -" + std::to_string(delta / floor) +
+                 " floors");
+    const Eigen::MatrixXd lambda = raise(delta);
+    internal::VerificationResult fresh;
+    const internal::VerificationResult h = verify_held(lambda, delta, &fresh);
+    EXPECT_TRUE(fresh.certified);
+    EXPECT_TRUE(h.certified);
+    EXPECT_EQ(h.factorizations,
+              fresh.factorizations - (delta > 10 * floor ? 1 : 0));
+    EXPECT_EQ(h.extended_factorizations, 0);
+    EXPECT_NEAR(h.lambda_min_estimate, -delta, 0.05 * delta);
+    EXPECT_LE(h.lambda_min_estimate, fresh.lambda_min_estimate + 1e-3 * delta);
+    EXPECT_LT(h.eta, 2 * delta);
+    EXPECT_EQ(reference.NegativePivots(lambda, h.eta), 0)
+        << "FALSE CERTIFICATE at eta " << h.eta;
+  }
+
   // A known shift within 2x of what double reaches (1.5 floors; a descent's
   // test proven at double's reach, internal::PlanDescentTest) is not
   // tightened: the factor and the Lanczos estimate would cost about three

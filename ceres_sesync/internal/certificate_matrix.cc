@@ -316,15 +316,24 @@ bool CertificateMatrix::SettleShift(double head, double* mu) const {
 
 double CertificateMatrix::DoubleShiftCost(
     const Eigen::MatrixXd& offsets) const {
-  if (offsets.size() == 0) return 0;
+  return ShiftCost(double_shift_, offsets);
+}
+
+double CertificateMatrix::FactorShiftCost(
+    const Eigen::MatrixXd& offsets) const {
+  return ShiftCost(factorized_shift_, offsets);
+}
+
+double CertificateMatrix::ShiftCost(const std::vector<double>& shifts,
+                                    const Eigen::MatrixXd& offsets) const {
+  if (offsets.size() == 0 || shifts.empty()) return 0;
   CHECK_EQ(offsets.cols(), translation_size_);
   // S's near-null directions x_a (row a of the rotations, |x_a|^2 = n) move
   // translation row j by offsets(a, j): to first order the shift lowers
   // lambda_min(S) by the largest eigenvalue of C = sum_j mu_j o_j o_j^T / n
   // (d x d; the coordinates' cross terms count: up to d times the largest
   // diagonal entry where offsets are correlated, as from a corner).
-  const Eigen::Map<const Eigen::VectorXd> mu(double_shift_.data(),
-                                             translation_size_);
+  const Eigen::Map<const Eigen::VectorXd> mu(shifts.data(), translation_size_);
   const Eigen::MatrixXd C =
       offsets * mu.asDiagonal() * offsets.transpose() / n_;
   return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(C,

@@ -133,6 +133,10 @@ class CertificateMatrix {
   // (One mu for all rows and the largest coordinate's sum, as before, cost
   // 3-100x more on the benchmark maps.)
   double DoubleShiftCost(const Eigen::MatrixXd& offsets) const;
+  // The same for the shifts of the current double factor
+  // (translation_shifts(); 0 after Factorize()): how far below
+  // lambda_min(S) a Lanczos estimate from that factor (of S_M) can be.
+  double FactorShiftCost(const Eigen::MatrixXd& offsets) const;
   // t_k - t_gauge for the translation nodes k of T (d x
   // problem.num_translations(), RecoverTranslations()'s layout), by K's
   // translation row.
@@ -189,6 +193,9 @@ class CertificateMatrix {
   void Assemble(const Eigen::MatrixXd& Lambda, double c,
                 const std::vector<double>& mu, std::vector<double>* rounding);
   bool ProveDouble(const Eigen::MatrixXd& Lambda, double c);
+  // DoubleShiftCost() for the shifts mu (empty: 0).
+  double ShiftCost(const std::vector<double>& mu,
+                   const Eigen::MatrixXd& offsets) const;
   // The double factorization of K_, counted and timed; true iff it completed.
   bool FactorizeDouble();
   bool ProveDoubleDouble(const Eigen::MatrixXd& Lambda, double c);

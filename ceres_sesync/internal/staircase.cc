@@ -539,9 +539,14 @@ bool Staircase::TestCertificate(double eta, ProofPrecision precision,
     passed_test_shift_ = certificate_->proven_shift();
     passed_test_precision_ = precision;
     passed_test_tighten_ = tighten;
+    passed_test_factor_ = precision == ProofPrecision::kDouble ? eta : 0;
   }
-  // Verify() factorizes again; only the symbolic analysis is kept meanwhile.
-  certificate_->ReleaseFactor();
+  // A failed test's descent goes on: only the symbolic analysis is kept
+  // meanwhile. A passed double test's factor is kept for the level's
+  // verification, which follows at once (its Lanczos estimate).
+  if (!passed || precision != ProofPrecision::kDouble) {
+    certificate_->ReleaseFactor();
+  }
   ++level->certificate_tests;
   level->factorizations +=
       certificate_->double_factorizations() - double_before;
@@ -820,6 +825,7 @@ VerificationResult Staircase::Verify(const Eigen::MatrixXd& Y,
                       : passed_test_shift_;
       verification_options.known_precision = passed_test_precision_;
       verification_options.tighten_known_shift = passed_test_tighten_;
+      verification_options.known_shift_factor = passed_test_factor_;
     }
   }
   passed_test_lambda_.resize(0, 0);

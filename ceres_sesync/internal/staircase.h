@@ -257,6 +257,8 @@ class Staircase {
   Eigen::MatrixXd passed_test_lambda_;
   double passed_test_shift_ = 0;
   ProofPrecision passed_test_precision_ = ProofPrecision::kDouble;
+  // The c of its double factor, still held (0: none; a double-double test).
+  double passed_test_factor_ = 0;
   // Whether the level's verification may tighten that proof (not after a
   // test near convergence: it was the verification's own first proof).
   bool passed_test_tighten_ = true;

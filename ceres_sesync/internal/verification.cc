@@ -305,10 +305,24 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     if (!options.tighten_known_shift) return finish();
     const double start = std::max(
         {eta_target, 1.5 * double_floor, std::numeric_limits<double>::min()});
+    const bool held = options.known_shift_factor > 0;
     if (first == ProofPrecision::kDouble && start < 0.5 * result.eta &&
-        fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
-        matrix->Factorize(Lambda, result.eta)) {
-      const double lambda_min = estimate_lambda_min(result.eta);
+        (held || (fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
+                  matrix->Factorize(Lambda, result.eta)))) {
+      double lambda_min =
+          estimate_lambda_min(held ? options.known_shift_factor : result.eta);
+      // The held factor's estimate is of S_M, below lambda_min(S) by up to
+      // what its translation shifts M cost. Where that is over 5% of the
+      // estimate (a lambda_min within a few floors of zero), the proofs
+      // below would start that much too high: a factor at the known shift,
+      // without M, estimates S's own.
+      if (held && std::isfinite(lambda_min) &&
+          matrix->FactorShiftCost(options.translation_offsets) >
+              0.05 * std::abs(lambda_min) &&
+          fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
+          matrix->Factorize(Lambda, result.eta)) {
+        lambda_min = estimate_lambda_min(result.eta);
+      }
       result.lambda_min_estimate = lambda_min;
       // Without an estimate (Lanczos did not converge) there is nothing to
       // tighten towards: no proof is tried.

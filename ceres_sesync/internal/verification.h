@@ -83,6 +83,15 @@ struct VerificationOptions {
   // convergence, SolverOptions::test_certificate_near_convergence, ran step
   // 1's proof already; step 1 would stop there too).
   bool tighten_known_shift = true;
+  // > 0: the matrix still holds the double factor of the test that proved
+  // known_shift, of K_c at this c (with that proof's translation shifts M).
+  // The known-shift tightening then estimates lambda_min by Lanczos on it
+  // instead of factorizing again at known_shift: an estimate of
+  // lambda_min(S_M), below lambda_min(S) by at most what M costs
+  // (CertificateMatrix::DoubleShiftCost, about double's floor), which the
+  // proofs' start above the estimate (10% of it, at least 1.5 floors)
+  // covers. Estimates only: the proofs are new factorizations either way.
+  double known_shift_factor = 0;
   // No factorization is started that is predicted to end after this
   // (CertificateMatrix::PredictedSeconds), double-double ones stop at it,
   // and nothing starts once it has passed; the result then has out_of_time
