@@ -193,8 +193,8 @@ class CertificateMatrix {
   void Assemble(const Eigen::MatrixXd& Lambda, double c,
                 const std::vector<double>& mu, std::vector<double>* rounding);
   bool ProveDouble(const Eigen::MatrixXd& Lambda, double c);
-  // DoubleShiftCost() for the shifts mu (empty: 0).
-  double ShiftCost(const std::vector<double>& mu,
+  // DoubleShiftCost() for the translation rows' `shifts` (empty: 0).
+  double ShiftCost(const std::vector<double>& shifts,
                    const Eigen::MatrixXd& offsets) const;
   // The double factorization of K_, counted and timed; true iff it completed.
   bool FactorizeDouble();

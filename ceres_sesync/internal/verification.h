@@ -88,9 +88,9 @@ struct VerificationOptions {
   // The known-shift tightening then estimates lambda_min by Lanczos on it
   // instead of factorizing again at known_shift: an estimate of
   // lambda_min(S_M), below lambda_min(S) by at most what M costs
-  // (CertificateMatrix::DoubleShiftCost, about double's floor), which the
-  // proofs' start above the estimate (10% of it, at least 1.5 floors)
-  // covers. Estimates only: the proofs are new factorizations either way.
+  // (CertificateMatrix::FactorShiftCost, about double's floor). Where that
+  // is over 5% of the estimate, the factor at known_shift is made after
+  // all. Estimates only: the proofs are new factorizations either way.
   double known_shift_factor = 0;
   // No factorization is started that is predicted to end after this
   // (CertificateMatrix::PredictedSeconds), double-double ones stop at it,
