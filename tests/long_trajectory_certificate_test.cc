@@ -455,8 +455,8 @@ TEST_P(LongTrajectoryCertificate, ProvenShiftBoundsTheTrueLambdaMin) {
       *fresh = internal::VerifyCertificate(problem, lambda, o, &matrix);
     }
     internal::CertificateMatrix matrix(problem);
-    EXPECT_TRUE(matrix.Prove(lambda, o.known_shift,
-                             internal::ProofPrecision::kDouble));
+    EXPECT_TRUE(
+        matrix.Prove(lambda, o.known_shift, internal::ProofPrecision::kDouble));
     o.known_shift_factor = o.known_shift;
     o.known_shift = matrix.proven_shift();
     return internal::VerifyCertificate(problem, lambda, o, &matrix);
