@@ -111,7 +111,7 @@ TEST(StaircaseContinue, ProvesTheBoundTheRoundedPosesNeed) {
   options.num_threads = 1;
   const double tol = options.certification_max_relative_bound;
   SolverSummary before;
-  const Solution x0 = SolveWithoutContinue(graph, options, &before);
+  SolveWithoutContinue(graph, options, &before);
   // The fixture: certified relaxation, rounded poses above the tolerance,
   // with the relaxation's own gap below it.
   ASSERT_EQ(before.status, SolverSummary::Status::kBoundAboveTolerance)

@@ -1096,6 +1096,12 @@ Solution Staircase::Round(const Eigen::MatrixXd& Y) {
   return solution;
 }
 
+double Staircase::Objective(const Solution& solution) const {
+  return problem_->weights().empty()
+             ? EvaluateObjective(graph_, solution)
+             : WeightedObjective(graph_, problem_->weights(), solution.poses);
+}
+
 bool Staircase::Continue(Eigen::MatrixXd* Y, Solution* solution) {
   AwaitSetup();
   SolverSummary& s = *summary_;
@@ -1133,12 +1139,7 @@ bool Staircase::Continue(Eigen::MatrixXd* Y, Solution* solution) {
     const double first_rounding_s = s.rounding_time_s;
     Solution again = Round(*Y);
     s.rounding_time_s += first_rounding_s;
-    auto objective = [&](const Solution& x) {
-      return problem_->weights().empty()
-                 ? EvaluateObjective(graph_, x)
-                 : WeightedObjective(graph_, problem_->weights(), x.poses);
-    };
-    if (objective(again) < objective(*solution)) *solution = std::move(again);
+    if (Objective(again) < Objective(*solution)) *solution = std::move(again);
     return true;
   }
   *Y = Y_before;
@@ -1186,10 +1187,7 @@ void Staircase::TightenProof(const Eigen::MatrixXd& Y, double objective) {
 void Staircase::Report(const Eigen::MatrixXd& Y, const Solution& solution) {
   AwaitSetup();
   SolverSummary& s = *summary_;
-  s.objective =
-      problem_->weights().empty()
-          ? EvaluateObjective(graph_, solution)
-          : WeightedObjective(graph_, problem_->weights(), solution.poses);
+  s.objective = Objective(solution);
   if (extended_deferred_ && verification_.certified) {
     TightenProof(Y, s.objective);
   }

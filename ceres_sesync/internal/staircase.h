@@ -201,6 +201,8 @@ class Staircase {
   // it proved a shift within the goal's.
   bool TestNearConvergence(const Eigen::MatrixXd& Y, double f, double eta,
                            SolverSummary::Level* level);
+  // F of `solution` for the problem's measurement weights (all 1 if none).
+  double Objective(const Solution& solution) const;
   // The deferred double-double proof (see Report()).
   void TightenProof(const Eigen::MatrixXd& Y, double objective);
   // Keeps the last verified level's rounding (verified_rounding_) as

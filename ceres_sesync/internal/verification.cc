@@ -306,9 +306,12 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
     const double start = std::max(
         {eta_target, 1.5 * double_floor, std::numeric_limits<double>::min()});
     const bool held = options.known_shift_factor > 0;
+    auto factor_at_known_shift = [&] {
+      return fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
+             matrix->Factorize(Lambda, result.eta);
+    };
     if (first == ProofPrecision::kDouble && start < 0.5 * result.eta &&
-        (held || (fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
-                  matrix->Factorize(Lambda, result.eta)))) {
+        (held || factor_at_known_shift())) {
       double lambda_min =
           estimate_lambda_min(held ? options.known_shift_factor : result.eta);
       // The held factor's estimate is of S_M, below lambda_min(S) by up to
@@ -319,8 +322,7 @@ VerificationResult VerifyCertificate(const SESyncProblem& problem,
       if (held && std::isfinite(lambda_min) &&
           matrix->FactorShiftCost(options.translation_offsets) >
               0.05 * std::abs(lambda_min) &&
-          fits(matrix->PredictedSeconds(ProofPrecision::kDouble)) &&
-          matrix->Factorize(Lambda, result.eta)) {
+          factor_at_known_shift()) {
         lambda_min = estimate_lambda_min(result.eta);
       }
       result.lambda_min_estimate = lambda_min;
