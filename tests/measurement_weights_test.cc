@@ -19,6 +19,7 @@
 #include "ceres_sesync/internal/sesync_cost.h"
 #include "ceres_sesync/internal/sesync_problem.h"
 #include "ceres_sesync/internal/staircase.h"
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/sesync_solver.h"
 #include "ceres_sesync/stiefel_manifold.h"
 #include "gmock/gmock.h"
@@ -81,7 +82,7 @@ PoseGraph Scaled(const PoseGraph& graph, const MeasurementWeights& w) {
 PoseGraph Inliers(const PoseGraph& graph, const MeasurementWeights& w) {
   PoseGraph inliers = graph;
   inliers.measurements.clear();
-  for (size_t k = 0; k < w.size(); ++k) {
+  for (size_t k = 0; k < graph.measurements.size(); ++k) {
     if (w[k] == 1) inliers.measurements.push_back(graph.measurements[k]);
   }
   return inliers;
@@ -181,9 +182,10 @@ TEST(MeasurementWeights, ObjectiveAndBoundAreThoseOfTheScaledGraph) {
     const WeightedCase c = MakeCase(d, 11, false);
     const PoseGraph scaled = Scaled(c.graph, c.weights);
     const Poses poses = test_util::RandomPoses(d, c.graph.num_poses, 2.0, &rng);
-    EXPECT_EQ(internal::WeightedObjective(c.graph, c.weights, poses),
-              EvaluateObjective(scaled, poses));
-    EXPECT_EQ(internal::WeightedObjective(c.graph, {}, poses),
+    EXPECT_EQ(
+        internal::WeightedObjective(c.graph, c.weights, Solution{poses, {}}),
+        EvaluateObjective(scaled, poses));
+    EXPECT_EQ(internal::WeightedObjective(c.graph, {}, Solution{poses, {}}),
               EvaluateObjective(c.graph, poses));
     EXPECT_EQ(internal::ObjectiveUpperBound(c.graph, poses, {}, c.weights),
               internal::ObjectiveUpperBound(scaled, poses));
@@ -311,7 +313,7 @@ TEST(MeasurementWeights, ReweightedStaircaseEqualsFreshStaircase) {
     EXPECT_EQ(first.objective, second.objective);
     EXPECT_EQ(first.lower_bound, second.lower_bound);
     EXPECT_EQ(second.objective,
-              internal::WeightedObjective(a.graph, w2, p_fresh));
+              internal::WeightedObjective(a.graph, w2, Solution{p_fresh, {}}));
     EXPECT_TRUE(first.certified()) << first.FullReport();
     ASSERT_EQ(p_reused.size(), p_fresh.size());
     for (size_t i = 0; i < p_fresh.size(); ++i) {
@@ -361,6 +363,202 @@ TEST(MeasurementWeights, DisconnectingOrInvalidWeightsAreRejected) {
   bad.pop_back();
   EXPECT_FALSE(internal::CheckMeasurementWeights(c.graph, bad, &error));
   EXPECT_THAT(error, ::testing::HasSubstr("weights for"));
+}
+
+// A landmark graph with GPS-like position priors and a start prior, and
+// weights for every term: odometry in [0.25, 1], landmark measurements and
+// priors in [0, 1] with about a third of them 0 (binary: {0, 1}) where the
+// graph stays connected (every landmark keeps its first observation, pose 0
+// its start prior).
+WeightedCase MakeLandmarkCase(int d, uint64_t seed, bool binary) {
+  LandmarkGraphOptions o;
+  o.dimension = d;
+  o.num_poses = 24;
+  o.num_landmarks = d == 2 ? 20 : 30;
+  o.world_size = 12;
+  o.block_length = 3;
+  o.gps_interval = 4;
+  o.start_prior = true;
+  o.seed = seed;
+  WeightedCase c;
+  std::string error;
+  EXPECT_TRUE(GenerateLandmarkGraph(o, &c.graph, nullptr, &error)) << error;
+  std::mt19937_64 rng(seed + 200);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  auto draw = [&](bool keep) {
+    const double u = uniform(rng);
+    double w = u < 1.0 / 3 ? 0.0 : (binary ? 1.0 : uniform(rng));
+    if (keep) w = binary ? 1.0 : std::max(w, 0.25);
+    return w;
+  };
+  for (size_t k = 0; k < c.graph.measurements.size(); ++k) {
+    c.weights.push_back(draw(true));  // Odometry: connected.
+  }
+  std::vector<char> seen(c.graph.num_landmarks, 0);
+  for (const LandmarkMeasurement& o : c.graph.landmark_measurements) {
+    c.weights.push_back(draw(!seen[o.l]));
+    seen[o.l] = 1;
+  }
+  for (const PosePrior& p : c.graph.priors) {
+    c.weights.push_back(draw(p.has_rotation()));  // The start prior.
+  }
+  return c;
+}
+
+// nu, kappa and tau of every term replaced by the weighted precisions
+// (weights > 0: a term of precision 0 is not a valid term).
+PoseGraph ScaledAll(const PoseGraph& graph, const MeasurementWeights& w) {
+  PoseGraph scaled = Scaled(graph, w);
+  for (size_t q = 0; q < scaled.landmark_measurements.size(); ++q) {
+    scaled.landmark_measurements[q].nu *= w[internal::LandmarkTerm(graph, q)];
+  }
+  for (size_t q = 0; q < scaled.priors.size(); ++q) {
+    scaled.priors[q].kappa *= w[internal::PriorTerm(graph, q)];
+    scaled.priors[q].tau *= w[internal::PriorTerm(graph, q)];
+  }
+  return scaled;
+}
+
+// The terms of weight 1 alone (weights in {0, 1}).
+PoseGraph InlierTerms(const PoseGraph& graph, const MeasurementWeights& w) {
+  PoseGraph inliers = Inliers(graph, w);
+  inliers.landmark_measurements.clear();
+  inliers.priors.clear();
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    if (w[internal::LandmarkTerm(graph, q)] == 1) {
+      inliers.landmark_measurements.push_back(graph.landmark_measurements[q]);
+    }
+  }
+  for (size_t q = 0; q < graph.priors.size(); ++q) {
+    if (w[internal::PriorTerm(graph, q)] == 1) {
+      inliers.priors.push_back(graph.priors[q]);
+    }
+  }
+  return inliers;
+}
+
+// Weights reach the landmark measurements and the priors: the matrices,
+// objective and bound are bitwise those of the graph with those precisions
+// scaled.
+TEST(MeasurementWeights, LandmarkAndPriorTermsAreWeighted) {
+  std::mt19937_64 rng(9);
+  for (int d : {2, 3}) {
+    WeightedCase c = MakeLandmarkCase(d, 3, false);
+    for (size_t k = c.graph.measurements.size(); k < c.weights.size(); ++k) {
+      c.weights[k] = std::max(c.weights[k], 0.125);
+    }
+    ASSERT_EQ(c.weights.size(), internal::NumWeightedTerms(c.graph));
+    ASSERT_TRUE(internal::CheckMeasurementWeights(c.graph, c.weights, nullptr));
+    const PoseGraph scaled = ScaledAll(c.graph, c.weights);
+    ASSERT_TRUE(ValidatePoseGraph(scaled, nullptr));
+    const SESyncProblem weighted(c.graph, 1, c.weights);
+    const SESyncProblem reference(scaled);
+    ASSERT_TRUE(weighted.ok() && reference.ok());
+    EXPECT_EQ(Dense(weighted.D()), Dense(reference.D()));
+    EXPECT_EQ(Dense(weighted.Vbar()), Dense(reference.Vbar()));
+    EXPECT_EQ(Dense(weighted.Lbar()), Dense(reference.Lbar()));
+    // ... and differ from the unweighted problem's (the weights are used).
+    EXPECT_NE(Dense(weighted.Lbar()), Dense(SESyncProblem(c.graph).Lbar()));
+
+    Solution x{test_util::RandomPoses(d, c.graph.num_poses, 2.0, &rng), {}};
+    std::normal_distribution<double> normal;
+    for (int l = 0; l < c.graph.num_landmarks; ++l) {
+      x.landmarks.push_back(Eigen::VectorXd::NullaryExpr(
+          d, [&](Eigen::Index) { return 3 * normal(rng); }));
+    }
+    EXPECT_EQ(internal::WeightedObjective(c.graph, c.weights, x),
+              EvaluateObjective(scaled, x));
+    EXPECT_EQ(
+        internal::ObjectiveUpperBound(c.graph, x.poses, x.landmarks, c.weights),
+        internal::ObjectiveUpperBound(scaled, x.poses, x.landmarks));
+    EXPECT_EQ(internal::TotalPrecision(c.graph, c.weights),
+              internal::TotalPrecision(scaled));
+  }
+}
+
+// Weights in {0, 1} on a landmark graph with priors: the weighted
+// staircase, built at once and re-weighted from all-one weights, reaches
+// the certified optimum of the graph of the weight-1 terms.
+TEST(MeasurementWeights, BinaryLandmarkAndPriorWeightsGiveTheInlierOptimum) {
+  for (int d : {2, 3}) {
+    WeightedCase c = MakeLandmarkCase(d, 5, /*binary=*/true);
+    for (size_t q = 0; q < c.graph.priors.size(); q += 2) {  // Some GPS ones.
+      if (!c.graph.priors[q].has_rotation()) {
+        c.weights[internal::PriorTerm(c.graph, q)] = 0;
+      }
+    }
+    const PoseGraph inliers = InlierTerms(c.graph, c.weights);
+    ASSERT_LT(inliers.landmark_measurements.size(),
+              c.graph.landmark_measurements.size());
+    ASSERT_LT(inliers.priors.size(), c.graph.priors.size());
+    ASSERT_TRUE(ValidatePoseGraph(inliers, nullptr));
+    SolverOptions options;
+    options.num_threads = 1;
+    SolverSummary reference;
+    Solution optimum;
+    Solve(inliers, options, &optimum, &reference);
+    ASSERT_TRUE(reference.certified()) << reference.FullReport();
+
+    SolverSummary summary;
+    internal::Staircase staircase(c.graph, options, &summary);
+    ASSERT_TRUE(staircase.ok());
+    ASSERT_TRUE(staircase.Reweight(c.weights));
+    EXPECT_EQ(summary.num_landmark_measurements,
+              static_cast<int>(inliers.landmark_measurements.size()));
+    EXPECT_EQ(summary.num_priors, static_cast<int>(inliers.priors.size()));
+    Eigen::MatrixXd Y;
+    ASSERT_TRUE(staircase.Initialize(nullptr, &Y));
+    staircase.Run(&Y);
+    const Solution x = staircase.Round(Y);
+    staircase.Report(Y, x);
+    EXPECT_TRUE(summary.certified()) << summary.FullReport();
+    EXPECT_NEAR(summary.objective, reference.objective,
+                1e-9 * reference.objective);
+    EXPECT_NEAR(summary.lower_bound, reference.lower_bound,
+                1e-8 * reference.objective);
+    EXPECT_NEAR(EvaluateObjective(inliers, x), reference.objective,
+                1e-9 * reference.objective);
+    // With priors the frame is the world's: the poses themselves agree.
+    for (int i = 0; i < c.graph.num_poses; ++i) {
+      EXPECT_LT((x.poses[i].t - optimum.poses[i].t).norm(), 1e-6) << i;
+      EXPECT_LT((x.poses[i].R - optimum.poses[i].R).norm(), 1e-6) << i;
+    }
+  }
+}
+
+// Zero weights on every observation of a landmark, or on every prior,
+// disconnect the problem: rejected with a message naming what is cut off.
+TEST(MeasurementWeights, CutOffLandmarkOrWorldIsRejected) {
+  const WeightedCase c = MakeLandmarkCase(2, 7, /*binary=*/true);
+  const PoseGraph& g = c.graph;
+  MeasurementWeights w(internal::NumWeightedTerms(g), 1.0);
+  const int l = g.landmark_measurements[0].l;
+  for (size_t q = 0; q < g.landmark_measurements.size(); ++q) {
+    if (g.landmark_measurements[q].l == l) w[internal::LandmarkTerm(g, q)] = 0;
+  }
+  std::string error;
+  EXPECT_FALSE(internal::CheckMeasurementWeights(g, w, &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("landmark " +
+                                          std::to_string(g.landmark_ids[l])));
+  w.assign(w.size(), 1.0);
+  for (size_t q = 0; q < g.priors.size(); ++q) {
+    w[internal::PriorTerm(g, q)] = 0;
+  }
+  EXPECT_FALSE(internal::CheckMeasurementWeights(g, w, &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("world frame"));
+  // Only the start prior (no position prior left with a position term
+  // among the GPS ones would still connect t_w through it): fine.
+  for (size_t q = 0; q < g.priors.size(); ++q) {
+    w[internal::PriorTerm(g, q)] = g.priors[q].has_rotation() ? 1 : 0;
+  }
+  EXPECT_TRUE(internal::CheckMeasurementWeights(g, w, &error)) << error;
+  SolverSummary summary;
+  internal::Staircase staircase(g, SolverOptions(), &summary,
+                                internal::Staircase::Clock::now(), w);
+  EXPECT_TRUE(staircase.ok()) << summary.message;
+  w.pop_back();
+  EXPECT_FALSE(internal::CheckMeasurementWeights(g, w, &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("terms"));
 }
 
 }  // namespace

@@ -848,9 +848,7 @@ TEST(RobustSolver, InvalidOptionsAndInputsAreReported) {
   EXPECT_THAT(s.BriefReport(), ::testing::HasSubstr("INVALID_INPUT"));
 }
 
-// Weights apply to pose-pose measurements only; graphs with landmarks or
-// priors are refused with a message (not solved with unweighted landmark
-// terms silently), by SolveRobust and by the weighted Staircase.
+// Graphs with landmarks or priors are refused with a message.
 TEST(RobustSolver, LandmarksAndPriorsAreRefusedClearly) {
   LandmarkGraphOptions generator;
   generator.num_poses = 30;
@@ -865,13 +863,6 @@ TEST(RobustSolver, LandmarksAndPriorsAreRefusedClearly) {
   EXPECT_EQ(s.status, RobustSolverSummary::Status::kInvalidInput);
   EXPECT_THAT(s.message, ::testing::HasSubstr("landmarks or priors"));
 
-  SolverSummary summary;
-  internal::Staircase staircase(
-      graph, SolverOptions(), &summary, internal::Staircase::Clock::now(),
-      internal::MeasurementWeights(graph.measurements.size(), 1.0));
-  EXPECT_FALSE(staircase.ok());
-  EXPECT_EQ(summary.status, SolverSummary::Status::kInvalidInput);
-  EXPECT_THAT(summary.message, ::testing::HasSubstr("landmarks or priors"));
 }
 
 // Ceres with Huber and Cauchy losses on the same terms: the robust

@@ -66,31 +66,35 @@ double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
     error += w.kappa * rotation.error + w.tau * translation.error;
   }
   // Landmark residuals p_l - t_i - R_i z.
-  for (const LandmarkMeasurement& o : graph.landmark_measurements) {
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    const LandmarkMeasurement& o = graph.landmark_measurements[q];
+    const double nu = WeightedPrecision(o, weights, LandmarkTerm(graph, q));
     const Pose& a = poses[o.i];
     ResidualBound translation{d, g};
     translation.Translation(landmarks[o.l], a.t, a.R, o.z);
-    f += o.nu * translation.value;
-    error += o.nu * translation.error;
+    f += nu * translation.value;
+    error += nu * translation.error;
   }
   // Prior residuals R_i - R~ and t_i - g.
-  for (const PosePrior& p : graph.priors) {
+  for (size_t q = 0; q < graph.priors.size(); ++q) {
+    const PosePrior& p = graph.priors[q];
+    const Precisions w = WeightedPrecisions(p, weights, PriorTerm(graph, q));
     const Pose& a = poses[p.i];
     if (p.has_rotation()) {
       ResidualBound rotation{d, g};
       for (int q = 0; q < d * d; ++q) {
         rotation.Add(a.R(q) - p.R(q), std::abs(a.R(q)) + std::abs(p.R(q)));
       }
-      f += p.kappa * rotation.value;
-      error += p.kappa * rotation.error;
+      f += w.kappa * rotation.value;
+      error += w.kappa * rotation.error;
     }
     if (p.has_position()) {
       ResidualBound translation{d, g};
       for (int q = 0; q < d; ++q) {
         translation.Add(a.t(q) - p.t(q), std::abs(a.t(q)) + std::abs(p.t(q)));
       }
-      f += p.tau * translation.value;
-      error += p.tau * translation.error;
+      f += w.tau * translation.value;
+      error += w.tau * translation.error;
     }
   }
   // The sums (squares of entries, weights, terms) and this computation's
@@ -110,10 +114,15 @@ double TotalPrecision(const PoseGraph& graph,
     const Precisions w = WeightedPrecisions(graph.measurements[k], weights, k);
     total += w.kappa + w.tau;
   }
-  for (const LandmarkMeasurement& o : graph.landmark_measurements) {
-    total += o.nu;
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    total += WeightedPrecision(graph.landmark_measurements[q], weights,
+                               LandmarkTerm(graph, q));
   }
-  for (const PosePrior& p : graph.priors) total += p.kappa + p.tau;
+  for (size_t q = 0; q < graph.priors.size(); ++q) {
+    const Precisions w =
+        WeightedPrecisions(graph.priors[q], weights, PriorTerm(graph, q));
+    total += w.kappa + w.tau;
+  }
   return total;
 }
 

@@ -23,7 +23,7 @@ namespace ceres_sesync::internal {
 // like an edge from the identity pose. `landmarks` must hold one position
 // per landmark. With `weights`, the same for the weighted problem
 // (measurement_weights.h: its precisions are doubles, so the analysis is
-// unchanged; weights apply to the pose-pose measurements only).
+// unchanged; weights apply to every term).
 double ObjectiveUpperBound(const PoseGraph& graph, const Poses& poses,
                            const LandmarkPositions& landmarks = {},
                            const MeasurementWeights& weights = {});

@@ -293,7 +293,7 @@ SESyncProblem::SESyncProblem(const PoseGraph& graph, int num_threads,
       d_(graph.dimension),
       n_(layout_.num_rotations()),
       num_threads_(std::max(1, num_threads)) {
-  CHECK(weights_.empty() || weights_.size() == graph.measurements.size());
+  CHECK(weights_.empty() || weights_.size() == NumWeightedTerms(graph));
   const ProblemLayout& layout = layout_;
   const int N = layout.num_translations();
   // The ordering depends on the pattern alone: with a second thread it is
@@ -443,7 +443,7 @@ void SESyncProblem::FactorizeLbar() {
 }
 
 bool SESyncProblem::UpdateWeights(MeasurementWeights weights) {
-  CHECK(weights.empty() || weights.size() == graph_->measurements.size());
+  CHECK(weights.empty() || weights.size() == NumWeightedTerms(*graph_));
   AwaitLbar();
   weights_ = std::move(weights);
   const Eigen::Index nnz_D = D_.nonZeros(), nnz_V = Vbar_.nonZeros(),

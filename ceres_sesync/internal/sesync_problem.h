@@ -242,7 +242,7 @@ struct ProblemLayout {
 // landmark measurements (translation terms from pose i to node n + l with
 // t~ = z, tau = nu), then the priors (edges from w: rotation terms between
 // R_w and R_i with R~ if kappa > 0, translation terms from t_w to t_i with
-// t~ = g if tau > 0). Weights apply to the relative pose measurements. The
+// t~ = g if tau > 0). Weights apply to every term (measurement_weights.h). The
 // terms visited, and so the sparsity pattern, do not depend on the weights:
 // a zero weight visits exact zeros.
 enum class DataBlock { kTranslation, kCoupling, kRotation, kRotationSigma };
@@ -319,20 +319,24 @@ void ForEachDataTerm(const PoseGraph& graph, const MeasurementWeights& weights,
   }
   // Landmark measurements: pose i -> translation node n + l.
   const ProblemLayout layout(graph);
-  for (const LandmarkMeasurement& o : graph.landmark_measurements) {
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    const LandmarkMeasurement& o = graph.landmark_measurements[q];
     data_terms::VisitTranslationTerm<Scalar>(
-        d, o.i, o.i, layout.landmark_node(o.l), o.z, o.nu, visit);
+        d, o.i, o.i, layout.landmark_node(o.l), o.z,
+        WeightedPrecision(o, weights, LandmarkTerm(graph, q)), visit);
   }
   // Priors: edges from the world pose w to pose i.
-  for (const PosePrior& p : graph.priors) {
+  for (size_t q = 0; q < graph.priors.size(); ++q) {
+    const PosePrior& p = graph.priors[q];
+    const Precisions w = WeightedPrecisions(p, weights, PriorTerm(graph, q));
     if (p.has_rotation()) {
       data_terms::VisitRotationTerm<Scalar>(d, layout.world_rotation_block(),
-                                            p.i, p.R, p.kappa, visit);
+                                            p.i, p.R, w.kappa, visit);
     }
     if (p.has_position()) {
       data_terms::VisitTranslationTerm<Scalar>(
           d, layout.world_translation_node(), layout.world_rotation_block(),
-          p.i, p.t, p.tau, visit);
+          p.i, p.t, w.tau, visit);
     }
   }
 }

@@ -24,6 +24,21 @@ namespace {
 constexpr char kLbarNotPositiveDefinite[] =
     "the translational Laplacian is not positive definite";
 
+// The summary's counts of a weighted problem: its terms of positive weight.
+void CountPositiveTerms(const PoseGraph& graph,
+                        const MeasurementWeights& weights, SolverSummary* s) {
+  auto positive = [&](size_t begin, size_t end) {
+    return static_cast<int>(std::count_if(weights.begin() + begin,
+                                          weights.begin() + end,
+                                          [](double w) { return w > 0; }));
+  };
+  const size_t m = graph.measurements.size();
+  const size_t landmark_end = PriorTerm(graph, 0);
+  s->num_measurements = positive(0, m);
+  s->num_landmark_measurements = positive(m, landmark_end);
+  s->num_priors = positive(landmark_end, NumWeightedTerms(graph));
+}
+
 // Factorizations of at least this many multiply-adds (a double-double one
 // ~4 s on two threads here) test a likely optimal candidate's
 // near-optimality in double before its double-double proof
@@ -247,16 +262,7 @@ Staircase::Staircase(const PoseGraph& graph, const SolverOptions& options,
     s.status = SolverSummary::Status::kInvalidInput;
     return;
   }
-  if (!weights.empty() && (graph.num_landmarks > 0 || !graph.priors.empty())) {
-    s.status = SolverSummary::Status::kInvalidInput;
-    s.message =
-        "measurement weights are not supported with landmarks or priors";
-    return;
-  }
-  if (!weights.empty()) {
-    s.num_measurements = static_cast<int>(std::count_if(
-        weights.begin(), weights.end(), [](double w) { return w > 0; }));
-  }
+  if (!weights.empty()) CountPositiveTerms(graph, weights, &s);
   const ProblemLayout layout(graph);
   d_ = graph.dimension;
   n_ = layout.num_rotations();
@@ -374,28 +380,22 @@ bool Staircase::Reweight(MeasurementWeights weights, Clock::time_point start) {
   AwaitSetup();
   CHECK(problem_ != nullptr) << "Reweight() needs a valid, non-trivial problem";
   start_ = start;
-  const int m = static_cast<int>(graph_.measurements.size());
   SolverSummary& s = *summary_;
   s = SolverSummary();
   s.lambda_min_estimate = std::numeric_limits<double>::quiet_NaN();
   s.dimension = d_;
   s.num_poses = graph_.num_poses;
-  s.num_measurements =
-      weights.empty()
-          ? m
-          : static_cast<int>(std::count_if(weights.begin(), weights.end(),
-                                           [](double w) { return w > 0; }));
+  s.num_measurements = static_cast<int>(graph_.measurements.size());
+  s.num_landmarks = graph_.num_landmarks;
+  s.num_landmark_measurements =
+      static_cast<int>(graph_.landmark_measurements.size());
+  s.num_priors = static_cast<int>(graph_.priors.size());
   ok_ = false;
-  if (graph_.num_landmarks > 0 || !graph_.priors.empty()) {
-    s.status = SolverSummary::Status::kInvalidInput;
-    s.message =
-        "measurement weights are not supported with landmarks or priors";
-    return false;
-  }
   if (!CheckMeasurementWeights(graph_, weights, &s.message)) {
     s.status = SolverSummary::Status::kInvalidInput;
     return false;
   }
+  if (!weights.empty()) CountPositiveTerms(graph_, weights, &s);
   const auto t = Clock::now();
   if (!problem_->UpdateWeights(std::move(weights))) {
     s.status = SolverSummary::Status::kInvalidInput;
@@ -1099,7 +1099,7 @@ Solution Staircase::Round(const Eigen::MatrixXd& Y) {
 double Staircase::Objective(const Solution& solution) const {
   return problem_->weights().empty()
              ? EvaluateObjective(graph_, solution)
-             : WeightedObjective(graph_, problem_->weights(), solution.poses);
+             : WeightedObjective(graph_, problem_->weights(), solution);
 }
 
 bool Staircase::Continue(Eigen::MatrixXd* Y, Solution* solution) {

@@ -77,7 +77,7 @@ class Staircase {
   Solution Trivial() const;
 
   // Starts a new solve of the problem with these measurement weights
-  // (empty: all 1; they apply to the pose-pose measurements): the data
+  // (empty: all 1; one per term, measurement_weights.h): the data
   // matrices, the certificate matrix and the preconditioner get the new
   // values (same patterns: the symbolic analyses are kept), the summary is
   // reset as by the constructor (num_measurements: those of positive weight;
@@ -85,8 +85,7 @@ class Staircase {
   // false, with the summary's status kInvalidInput and a message, if the
   // weights fail CheckMeasurementWeights (e.g. the positively weighted
   // measurements leave the graph disconnected); ok() is then false until a
-  // successful Reweight(). Not for trivial problems, nor for graphs with
-  // landmarks or priors.
+  // successful Reweight(). Not for trivial problems.
   bool Reweight(MeasurementWeights weights,
                 Clock::time_point start = Clock::now());
 
