@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "Eigen/Geometry"
 #include "ceres_sesync/internal/rounding.h"
@@ -81,6 +82,36 @@ bool ReferenceTrajectory(const PoseGraph& graph, Poses* poses) {
     }
   }
   return true;
+}
+
+// Moves dead-reckoned poses rigidly onto the graph's position priors (least
+// squares over the prior positions: Kabsch's rotation with det +1, then the
+// translation), so that they are in the priors' world frame. Fewer than two
+// position priors: the translation only (none: unchanged).
+void AlignToPositionPriors(const PoseGraph& graph, Poses* poses) {
+  const int d = graph.dimension;
+  std::vector<std::pair<Eigen::VectorXd, Eigen::VectorXd>> pairs;
+  for (const PosePrior& p : graph.priors) {
+    if (p.has_position()) pairs.emplace_back((*poses)[p.i].t, p.t);
+  }
+  if (pairs.empty()) return;
+  Eigen::VectorXd mean_a = Eigen::VectorXd::Zero(d), mean_b = mean_a;
+  for (const auto& [a, b] : pairs) {
+    mean_a += a / pairs.size();
+    mean_b += b / pairs.size();
+  }
+  Eigen::MatrixXd R = Eigen::MatrixXd::Identity(d, d);
+  if (pairs.size() >= 2) {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(d, d);
+    for (const auto& [a, b] : pairs)
+      H += (b - mean_b) * (a - mean_a).transpose();
+    R = internal::ProjectToRotation(H);
+  }
+  const Eigen::VectorXd t = mean_b - R * mean_a;
+  for (Pose& x : *poses) {
+    x.R = R * x.R;
+    x.t = R * x.t + t;
+  }
 }
 
 }  // namespace
@@ -181,6 +212,86 @@ bool AddOutliers(const PoseGraph& graph, const OutlierOptions& options,
   }
   *corrupted = std::move(out);
   if (outlier_indices) *outlier_indices = std::move(added);
+  return true;
+}
+
+bool AddLandmarkOutliers(const PoseGraph& graph,
+                         const LandmarkOutlierOptions& options,
+                         PoseGraph* corrupted,
+                         std::vector<int>* landmark_outliers,
+                         std::vector<int>* prior_outliers, std::string* error) {
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  const double f_l = options.landmark_fraction, f_p = options.prior_fraction;
+  if (!(f_l >= 0 && f_l < 1) || !(f_p >= 0 && f_p < 1)) {
+    return fail("the outlier fractions must be in [0, 1)");
+  }
+  std::string why;
+  if (!ValidatePoseGraph(graph, &why)) return fail("invalid graph: " + why);
+  const int d = graph.dimension, n = graph.num_poses;
+  const int M = static_cast<int>(graph.landmark_measurements.size());
+  if (f_l > 0 && graph.num_landmarks < 2) {
+    return fail("wrong landmark associations need at least two landmarks");
+  }
+  std::vector<double> taus;
+  for (const PosePrior& p : graph.priors) {
+    if (p.has_position()) taus.push_back(p.tau);
+  }
+  const int P = static_cast<int>(taus.size());
+  Poses reference;
+  if (f_p > 0) {
+    if (P == 0) {
+      return fail(
+          "false position fixes need position priors (the fraction is "
+          "relative to them)");
+    }
+    if (!ReferenceTrajectory(graph, &reference)) {
+      return fail(
+          "false position fixes need a reference trajectory: the graph has "
+          "no initial poses and its odometry chain is incomplete");
+    }
+    if (graph.initial_poses.empty()) AlignToPositionPriors(graph, &reference);
+  }
+  PoseGraph out = graph;
+  std::mt19937_64 rng(options.seed);
+  std::vector<int> added_l, added_p;
+  const int count_l = static_cast<int>(std::lround(f_l * M / (1 - f_l)));
+  const int64_t L = graph.num_landmarks;
+  if (count_l > L * (L - 1)) {
+    return fail("too many wrong associations for " + std::to_string(L) +
+                " landmarks (each pair of landmarks is used once)");
+  }
+  std::set<int64_t> pairs;  // l * L + l' of the wrong associations so far.
+  while (static_cast<int>(added_l.size()) < count_l) {
+    LandmarkMeasurement o = graph.landmark_measurements[UniformIndex(M, &rng)];
+    // Another landmark, uniformly.
+    const int other = UniformIndex(graph.num_landmarks - 1, &rng);
+    const int l = other < o.l ? other : other + 1;
+    if (!pairs.insert(o.l * L + l).second) continue;
+    o.l = l;
+    added_l.push_back(static_cast<int>(out.landmark_measurements.size()));
+    out.landmark_measurements.push_back(std::move(o));
+  }
+  const int count_p = static_cast<int>(std::lround(f_p * P / (1 - f_p)));
+  if (count_p > 0) {
+    const double tau = Median(taus);
+    const double sigma = 1 / std::sqrt(tau);
+    for (int k = 0; k < count_p; ++k) {
+      PosePrior p;
+      p.i = UniformIndex(n, &rng);
+      Eigen::VectorXd u = RandomTranslation(d, 1.0, &rng);
+      u.normalize();
+      p.t = reference[p.i].t + u * (sigma * (10 + 30 * SampleUniform01(&rng)));
+      p.tau = tau;
+      added_p.push_back(static_cast<int>(out.priors.size()));
+      out.priors.push_back(std::move(p));
+    }
+  }
+  *corrupted = std::move(out);
+  if (landmark_outliers) *landmark_outliers = std::move(added_l);
+  if (prior_outliers) *prior_outliers = std::move(added_p);
   return true;
 }
 

@@ -61,6 +61,47 @@ bool AddOutliers(const PoseGraph& graph, const OutlierOptions& options,
                  PoseGraph* corrupted, std::vector<int>* outlier_indices,
                  std::string* error);
 
+// Wrong data associations and false position fixes, for graphs with
+// landmarks or position priors: a copy of the graph with outlier landmark
+// measurements and priors appended (the input's come first, unchanged; the
+// relative pose measurements are the input's).
+//  - Wrong associations, k_L = round(F_L M / (1 - F_L)) for M landmark
+//    measurements: a uniformly random landmark measurement (i, l, z, nu)
+//    of the input attributed to a uniformly random other landmark l' != l,
+//    i.e. (i, l', z, nu): a front end matching an observation to the wrong
+//    landmark. No pair (l, l') is used twice (two such observations, from
+//    different poses, would agree with each other on where l' is: a
+//    consistent wrong cluster, not random outliers). One can fit by chance
+//    when l' lies within the noise of l.
+//  - False fixes, k_P = round(F_P P / (1 - F_P)) for P position priors
+//    (priors with a position term): a position prior on a uniformly random
+//    pose i at t_ref(i) (the initial poses, else dead reckoning along
+//    odometry moved rigidly onto the position priors by least squares) plus a
+//    jump in a uniform direction of 10 to 40 (uniformly) standard deviations
+//    tau^(-1/2) per axis, tau the median of the input's position priors, which
+//    it gets: a multipath jump.
+struct LandmarkOutlierOptions {
+  // F_L, in [0, 1): fraction of the output's landmark measurements that are
+  // wrong associations.
+  double landmark_fraction = 0.1;
+  // F_P, in [0, 1): fraction of the output's position priors that are
+  // false fixes.
+  double prior_fraction = 0;
+  uint64_t seed = 0;
+};
+
+// Writes the corrupted graph to `corrupted` and the indices of the added
+// landmark measurements and priors (into corrupted->landmark_measurements
+// and ->priors, ascending) to the index vectors (if not null). Returns false
+// with a message for invalid options, a graph that fails ValidatePoseGraph,
+// F_L > 0 without two landmarks, or F_P > 0 without a position prior or a
+// reference trajectory.
+bool AddLandmarkOutliers(const PoseGraph& graph,
+                         const LandmarkOutlierOptions& options,
+                         PoseGraph* corrupted,
+                         std::vector<int>* landmark_outliers,
+                         std::vector<int>* prior_outliers, std::string* error);
+
 }  // namespace ceres_sesync
 
 #endif  // CERES_SESYNC_OUTLIER_GENERATOR_H_

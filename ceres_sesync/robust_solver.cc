@@ -47,17 +47,44 @@ double TlsWeight(double r2, double mu, double c2) {
   return std::clamp(std::sqrt(c2 * mu * (mu + 1) / r2) - mu, 0.0, 1.0);
 }
 
-// f_k at `poses` for every measurement (unweighted: the TLS residuals).
-std::vector<double> Costs(const PoseGraph& graph, const Poses& poses) {
-  std::vector<double> f(graph.measurements.size());
-  for (size_t k = 0; k < f.size(); ++k) {
+// f_k at `x` for every term (measurement_weights.h's order; unweighted:
+// the TLS residuals).
+std::vector<double> Costs(const PoseGraph& graph, const Solution& x) {
+  const Poses& poses = x.poses;
+  std::vector<double> f(internal::NumWeightedTerms(graph));
+  const size_t m = graph.measurements.size();
+  for (size_t k = 0; k < m; ++k) {
     const RelativePoseMeasurement& e = graph.measurements[k];
     const Pose& a = poses[e.i];
     const Pose& b = poses[e.j];
     f[k] = e.kappa * (b.R - a.R * e.R).squaredNorm() +
            e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
   }
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    const LandmarkMeasurement& o = graph.landmark_measurements[q];
+    const Pose& a = poses[o.i];
+    f[m + q] = o.nu * (x.landmarks[o.l] - a.t - a.R * o.z).squaredNorm();
+  }
+  for (size_t q = 0; q < graph.priors.size(); ++q) {
+    const PosePrior& p = graph.priors[q];
+    const Pose& a = poses[p.i];
+    double& cost = f[internal::PriorTerm(graph, q)];
+    if (p.has_rotation()) cost += p.kappa * (a.R - p.R).squaredNorm();
+    if (p.has_position()) cost += p.tau * (a.t - p.t).squaredNorm();
+  }
   return f;
+}
+
+// Degrees of freedom of term k's f_k under the noise model: an edge
+// d(d+1)/2, a landmark measurement d, a prior d(d-1)/2 for its rotation
+// plus d for its position.
+int TermDegreesOfFreedom(const PoseGraph& graph, size_t k) {
+  const int d = graph.dimension;
+  const size_t m = graph.measurements.size();
+  if (k < m) return d * (d + 1) / 2;
+  if (k < internal::PriorTerm(graph, 0)) return d;
+  const PosePrior& p = graph.priors[k - internal::PriorTerm(graph, 0)];
+  return (p.has_rotation() ? d * (d - 1) / 2 : 0) + (p.has_position() ? d : 0);
 }
 
 double RotationAngle(const Eigen::MatrixXd& M) {
@@ -92,45 +119,158 @@ Eigen::MatrixXd ReduceRank(const Eigen::MatrixXd& Y, int d, int min_rank,
 // warm start (their directions change F by ~1e-6 of it).
 constexpr double kRankTolerance = 1e-3;
 
+// A landmark all of whose observations have weight 0 (or are rejected) is
+// free: its position no longer depends on the rest. One observation alone
+// is fit exactly (f_k = 0 wherever the rest is: the landmark is placed at
+// it), and as a leaf of the translational graph it changes nothing else,
+// so TLS keeps one of them at no cost. Sets `values` (weights, or
+// accepted flags) of the observation with the smallest f_k of every such
+// landmark to `one`.
+template <typename T>
+void KeepLandmarksObserved(const PoseGraph& graph, const std::vector<double>& f,
+                           std::vector<T>* values, T one) {
+  const size_t m = graph.measurements.size();
+  std::vector<int> best(graph.num_landmarks, -1);
+  std::vector<char> observed(graph.num_landmarks, 0);
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    const int l = graph.landmark_measurements[q].l;
+    if ((*values)[m + q] > 0) observed[l] = 1;
+    if (best[l] < 0 || f[m + q] < f[m + best[l]]) best[l] = static_cast<int>(q);
+  }
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    if (!observed[l] && best[l] >= 0) (*values)[m + best[l]] = one;
+  }
+}
+
+// The consistency rounds' choice for the landmark measurements, at the
+// poses of x: each landmark placed alone where the TLS cost of its
+// observations, sum_q min(f_q, c_q^2), is lowest among its current position
+// and the positions its observations imply (t_i + R_i z_q, where f_q = 0),
+// the current one on ties; then accepted iff f_q <= c_q^2 there. At the
+// current position this is the rule for every other term. It moves a
+// landmark that GNC left at a minority of its observations (wrong
+// associations outnumber the true ones of a landmark seen by few poses,
+// and one of them, fit exactly, can hold it) to a larger consistent group.
+// Lowers the TLS cost at the poses of x, like the rule itself.
+void LandmarkConsensus(const PoseGraph& graph, const Solution& x,
+                       const std::vector<double>& c2,
+                       std::vector<char>* accepted) {
+  const size_t m = graph.measurements.size();
+  std::vector<std::vector<int>> observations(graph.num_landmarks);
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    observations[graph.landmark_measurements[q].l].push_back(
+        static_cast<int>(q));
+  }
+  std::vector<Eigen::VectorXd> implied;  // t_i + R_i z_q.
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    const std::vector<int>& obs = observations[l];
+    implied.clear();
+    for (int q : obs) {
+      const LandmarkMeasurement& o = graph.landmark_measurements[q];
+      implied.push_back(x.poses[o.i].t + x.poses[o.i].R * o.z);
+    }
+    auto tls = [&](const Eigen::VectorXd& p) {
+      double cost = 0;
+      for (size_t a = 0; a < obs.size(); ++a) {
+        const double f = graph.landmark_measurements[obs[a]].nu *
+                         (p - implied[a]).squaredNorm();
+        cost += std::min(f, c2[m + obs[a]]);
+      }
+      return cost;
+    };
+    const Eigen::VectorXd* best = &x.landmarks[l];
+    double best_cost = tls(*best);
+    for (const Eigen::VectorXd& p : implied) {
+      const double cost = tls(p);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = &p;
+      }
+    }
+    for (size_t a = 0; a < obs.size(); ++a) {
+      const double f = graph.landmark_measurements[obs[a]].nu *
+                       (*best - implied[a]).squaredNorm();
+      (*accepted)[m + obs[a]] = f <= c2[m + obs[a]];
+    }
+  }
+}
+
 bool Binary(const MeasurementWeights& w, double tolerance) {
   return std::all_of(w.begin(), w.end(),
                      [&](double x) { return std::min(x, 1 - x) <= tolerance; });
 }
 
-// Verdicts, counts and diagnostics at `poses` for the final `weights` and
-// the rounded inlier set `accepted`.
-void FillEdges(const PoseGraph& graph, const Poses& poses,
+// Verdicts, counts and diagnostics at `x` for the final `weights` and the
+// rounded inlier set `accepted` (one per term), with thresholds `c2`.
+void FillEdges(const PoseGraph& graph, const Solution& x,
                const MeasurementWeights& weights,
                const std::vector<char>& known,
-               const std::vector<char>& accepted, double c2,
+               const std::vector<char>& accepted, const std::vector<double>& c2,
                RobustSolverSummary* s) {
+  using Kind = RobustSolverSummary::Edge::Kind;
+  const Poses& poses = x.poses;
   const size_t m = graph.measurements.size();
-  const std::vector<double> f = Costs(graph, poses);
-  s->edges.assign(m, {});
+  const size_t prior_begin = internal::PriorTerm(graph, 0);
+  const std::vector<double> f = Costs(graph, x);
+  s->edges.assign(f.size(), {});
   s->outlier_edges.clear();
+  s->outlier_landmark_measurements.clear();
+  s->outlier_priors.clear();
   s->num_inliers = s->num_outliers = 0;
   s->num_rejected_within_threshold = s->num_accepted_beyond_threshold = 0;
-  for (size_t k = 0; k < m; ++k) {
-    const RelativePoseMeasurement& e = graph.measurements[k];
-    const Pose& a = poses[e.i];
-    const Pose& b = poses[e.j];
+  auto pose_id = [&](int i) -> int64_t {
+    return graph.vertex_ids.empty() ? i : graph.vertex_ids[i];
+  };
+  for (size_t k = 0; k < f.size(); ++k) {
     RobustSolverSummary::Edge& edge = s->edges[k];
-    edge.vertex_i = graph.vertex_ids.empty() ? e.i : graph.vertex_ids[e.i];
-    edge.vertex_j = graph.vertex_ids.empty() ? e.j : graph.vertex_ids[e.j];
+    if (k < m) {
+      const RelativePoseMeasurement& e = graph.measurements[k];
+      const Pose& a = poses[e.i];
+      const Pose& b = poses[e.j];
+      edge.vertex_i = pose_id(e.i);
+      edge.vertex_j = pose_id(e.j);
+      edge.rotation_residual_deg =
+          RotationAngle(e.R.transpose() * a.R.transpose() * b.R) * (180 / kPi);
+      edge.translation_residual = (b.t - a.t - a.R * e.t).norm();
+    } else if (k < prior_begin) {
+      const LandmarkMeasurement& o = graph.landmark_measurements[k - m];
+      const Pose& a = poses[o.i];
+      edge.kind = Kind::kLandmark;
+      edge.index = static_cast<int>(k - m);
+      edge.vertex_i = pose_id(o.i);
+      edge.vertex_j =
+          graph.landmark_ids.empty() ? o.l : graph.landmark_ids[o.l];
+      edge.translation_residual = (x.landmarks[o.l] - a.t - a.R * o.z).norm();
+    } else {
+      const PosePrior& p = graph.priors[k - prior_begin];
+      const Pose& a = poses[p.i];
+      edge.kind = Kind::kPrior;
+      edge.index = static_cast<int>(k - prior_begin);
+      edge.vertex_i = edge.vertex_j = pose_id(p.i);
+      if (p.has_rotation()) {
+        edge.rotation_residual_deg =
+            RotationAngle(p.R.transpose() * a.R) * (180 / kPi);
+      }
+      if (p.has_position()) edge.translation_residual = (a.t - p.t).norm();
+    }
+    if (k < m) edge.index = static_cast<int>(k);
     edge.weight = weights.empty() ? 1.0 : weights[k];
     edge.inlier = accepted[k];
     edge.known_inlier = known[k];
     edge.cost = f[k];
-    edge.rotation_residual_deg =
-        RotationAngle(e.R.transpose() * a.R.transpose() * b.R) * (180 / kPi);
-    edge.translation_residual = (b.t - a.t - a.R * e.t).norm();
+    edge.threshold = c2[k];
     if (edge.inlier) {
       ++s->num_inliers;
-      if (!edge.known_inlier && f[k] > c2) ++s->num_accepted_beyond_threshold;
+      if (!edge.known_inlier && f[k] > c2[k]) {
+        ++s->num_accepted_beyond_threshold;
+      }
     } else {
       ++s->num_outliers;
-      s->outlier_edges.push_back(static_cast<int>(k));
-      if (f[k] <= c2) ++s->num_rejected_within_threshold;
+      (edge.kind == Kind::kMeasurement ? s->outlier_edges
+       : edge.kind == Kind::kLandmark  ? s->outlier_landmark_measurements
+                                       : s->outlier_priors)
+          .push_back(edge.index);
+      if (f[k] <= c2[k]) ++s->num_rejected_within_threshold;
     }
   }
 }
@@ -157,14 +297,14 @@ class WeightedProblem {
                                                        &summary_, start);
   }
 
-  // The problem with `weights` (one per graph measurement) for the next
+  // The problem with `weights` (one per term of the graph) for the next
   // solve; false with a message if they leave the graph disconnected. The
   // first call builds the problem unless Start() did.
   bool SetWeights(const MeasurementWeights& weights, std::string* message) {
     if (!internal::CheckMeasurementWeights(graph_, weights, message)) {
       return false;
     }
-    const size_t m = graph_.measurements.size();
+    const size_t m = weights.size();
     if (staircase_ == nullptr) return Rebuild(weights, message);
     const size_t pattern = index_.empty() ? m : index_.size();
     size_t positive = 0, zero_in_pattern = 0;
@@ -189,21 +329,32 @@ class WeightedProblem {
   int rebuilds() const { return rebuilds_; }
 
  private:
-  // Builds the problem on the subgraph of positive weights.
+  // Builds the problem on the subgraph of positive weights (the same poses
+  // and landmarks: CheckMeasurementWeights keeps every landmark observed).
   bool Rebuild(const MeasurementWeights& weights, std::string* message) {
     const size_t m = graph_.measurements.size();
+    const size_t prior_begin = internal::PriorTerm(graph_, 0);
     staircase_.reset();  // First: it refers to the subgraph.
-    if (sub_.measurements.empty() && sub_.num_poses == 0) {
+    if (sub_.num_poses == 0) {
       sub_ = graph_;  // Poses, ids, initial poses and FIX: Round()'s gauge.
     }
     sub_.measurements.clear();
+    sub_.landmark_measurements.clear();
+    sub_.priors.clear();
     index_.clear();
     MeasurementWeights sub_weights;
     bool all_one = true;
-    for (size_t k = 0; k < m; ++k) {
+    for (size_t k = 0; k < weights.size(); ++k) {
       if (!(weights[k] > 0)) continue;
       index_.push_back(static_cast<int>(k));
-      sub_.measurements.push_back(graph_.measurements[k]);
+      if (k < m) {
+        sub_.measurements.push_back(graph_.measurements[k]);
+      } else if (k < prior_begin) {
+        sub_.landmark_measurements.push_back(
+            graph_.landmark_measurements[k - m]);
+      } else {
+        sub_.priors.push_back(graph_.priors[k - prior_begin]);
+      }
       sub_weights.push_back(weights[k]);
       all_one = all_one && weights[k] == 1;
     }
@@ -217,8 +368,8 @@ class WeightedProblem {
 
   const PoseGraph& graph_;
   const SolverOptions& options_;
-  PoseGraph sub_;           // The pattern's measurements, once rebuilt.
-  std::vector<int> index_;  // Pattern measurement -> graph's (empty: all).
+  PoseGraph sub_;           // The pattern's terms, once rebuilt.
+  std::vector<int> index_;  // Pattern term -> graph's (empty: all).
   std::unique_ptr<internal::Staircase> staircase_;
   SolverSummary summary_;
   int rebuilds_ = 0;
@@ -303,7 +454,7 @@ struct GncRun {
   RobustSolverSummary::Run record;
   RobustSolverSummary::Status status = RobustSolverSummary::Status::kConverged;
   std::string message;
-  Poses poses;
+  Solution x;
   MeasurementWeights weights;
   std::vector<char> accepted;
   std::vector<RobustSolverSummary::Iteration> history;
@@ -315,13 +466,13 @@ struct GncRun {
   int pattern_rebuilds = 0;  // Of the run's problem.
 };
 
-// sum_k min(f_k, c^2) over the estimated measurements plus f_k of the known
-// inliers, at `poses`.
+// sum_k min(f_k, c_k^2) over the estimated terms plus f_k of the known
+// inliers.
 double TlsCost(const std::vector<double>& f, const std::vector<char>& known,
-               double c2) {
+               const std::vector<double>& c2) {
   double cost = 0;
   for (size_t k = 0; k < f.size(); ++k) {
-    cost += known[k] ? f[k] : std::min(f[k], c2);
+    cost += known[k] ? f[k] : std::min(f[k], c2[k]);
   }
   return cost;
 }
@@ -330,6 +481,13 @@ double TlsCost(const std::vector<double>& f, const std::vector<char>& known,
 
 Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
                   RobustSolverSummary* summary) {
+  Solution x;
+  SolveRobust(graph, options, &x, summary);
+  return std::move(x.poses);
+}
+
+void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
+                 Solution* solution, RobustSolverSummary* summary) {
   const auto start = Clock::now();
   RobustSolverSummary& s = *summary;
   s = RobustSolverSummary();
@@ -338,24 +496,41 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.dimension = d;
   s.num_poses = graph.num_poses;
   s.num_measurements = static_cast<int>(m);
-  auto finish = [&](RobustSolverSummary::Status status, Poses poses) {
+  s.num_landmark_measurements =
+      static_cast<int>(graph.landmark_measurements.size());
+  s.num_priors = static_cast<int>(graph.priors.size());
+  auto finish = [&](RobustSolverSummary::Status status, Solution x) {
     s.status = status;
     s.total_time_s = Seconds(start);
-    return poses;
+    *solution = std::move(x);
   };
   s.message = CheckOptions(options, d);
   if (!s.message.empty()) {
     s.message = "robust solver options: " + s.message;
     return finish(RobustSolverSummary::Status::kInvalidInput, {});
   }
-  if (graph.num_landmarks > 0 || !graph.priors.empty()) {
-    s.message =
-        "the robust solve does not support landmarks or priors yet (their "
-        "terms would need weights of their own)";
-    return finish(RobustSolverSummary::Status::kInvalidInput, {});
+  s.inlier_threshold = InlierThreshold(options, d);
+  // Every term's threshold c_k^2 (a relative pose measurement's is c^2),
+  // and the loops' length: the number of terms.
+  const size_t K = internal::NumWeightedTerms(graph);
+  std::vector<int> dofs(K);
+  for (size_t k = 0; k < K; ++k) dofs[k] = TermDegreesOfFreedom(graph, k);
+  std::vector<double> c2(K, s.inlier_threshold);
+  if (options.inlier_threshold <= 0) {
+    for (size_t k = m; k < K; ++k) {
+      c2[k] = internal::ChiSquareQuantile(options.inlier_probability, dofs[k]);
+    }
   }
-  const double c2 = InlierThreshold(options, d);
-  s.inlier_threshold = c2;
+  // The unknowns' degrees of freedom: d(d+1)/2 per pose and d per landmark,
+  // less the gauge's d(d+1)/2 without priors; and the terms' in `set`.
+  const long unknown_dofs =
+      d * (d + 1) / 2 * (graph.num_poses - (graph.priors.empty() ? 1L : 0L)) +
+      static_cast<long>(d) * graph.num_landmarks;
+  auto accepted_dofs = [&](const std::vector<char>& set) {
+    long sum = 0;
+    for (size_t k = 0; k < K; ++k) sum += set[k] ? dofs[k] : 0;
+    return sum;
+  };
 
   // The first solve is Solve() itself up to initial_max_rank. GNC's
   // weighted solves then stop their local searches at
@@ -398,7 +573,7 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     return finish(RobustSolverSummary::Status::kInvalidInput, {});
   };
   if (!first_problem.staircase().ok()) return invalid();
-  std::vector<char> known(m, 0);
+  std::vector<char> known(K, 0);  // Landmark measurements, priors: never.
   for (size_t k = 0; k < m; ++k) {
     known[k] =
         options.known_inliers == RobustSolverOptions::KnownInliers::kOdometry &&
@@ -408,23 +583,40 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     s.initial_summary = s.inlier_summary = first_problem.summary();
     s.weights_binary = true;
     return finish(RobustSolverSummary::Status::kConverged,
-                  first_problem.staircase().Trivial().poses);
+                  first_problem.staircase().Trivial());
   }
   Eigen::MatrixXd Y0;
   if (!first_problem.staircase().Initialize(nullptr, &Y0)) return invalid();
   first_problem.staircase().Run(&Y0);
-  Poses poses0 = first_problem.staircase().Round(Y0).poses;
-  auto max_estimated_cost = [&](const std::vector<double>& f) {
-    double max_f = 0;
-    for (size_t k = 0; k < m; ++k) {
-      if (!known[k]) max_f = std::max(max_f, f[k]);
+  Solution x0 = first_problem.staircase().Round(Y0);
+  // Whether every estimated term has f_k <= fraction * c_k^2.
+  auto within = [&](const std::vector<double>& f, double fraction) {
+    for (size_t k = 0; k < K; ++k) {
+      if (!known[k] && !(f[k] <= fraction * c2[k])) return false;
     }
-    return max_f;
+    return true;
   };
-  std::vector<double> f0 = Costs(graph, poses0);
-  double max_cost = max_estimated_cost(f0);
+  // The estimated term with the largest f_k / c_k^2 (-1: none), and the mu
+  // at which GNC starts at thresholds fraction * c^2 from f: GNC's
+  // g^2 / (2 max f_k - g^2) in the units of that term (Yang et al.'s
+  // surrogate is homogeneous in (f_k, c_k^2)).
+  auto worst = [&](const std::vector<double>& f) {
+    int w = -1;
+    for (size_t k = 0; k < K; ++k) {
+      if (!known[k] && (w < 0 || f[k] / c2[k] > f[w] / c2[w])) {
+        w = static_cast<int>(k);
+      }
+    }
+    return w;
+  };
+  auto initial_mu = [&](const std::vector<double>& f, double fraction) {
+    const int w = worst(f);
+    const double g2 = fraction * c2[w];
+    return g2 / (2 * f[w] - g2);
+  };
+  std::vector<double> f0 = Costs(graph, x0);
   first_options.max_rank = options.solver_options.max_rank;
-  if (max_cost <= c2 &&
+  if (within(f0, 1) &&
       first_problem.summary().status ==
           SolverSummary::Status::kMaxRankReached &&
       first_problem.summary().final_rank < first_options.max_rank &&
@@ -432,14 +624,13 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // Every measurement fits: perhaps this is the inlier problem. The
     // staircase continues where a rank cap stopped it (as Solve() would).
     first_problem.staircase().Run(&Y0);
-    poses0 = first_problem.staircase().Round(Y0).poses;
-    f0 = Costs(graph, poses0);
-    max_cost = max_estimated_cost(f0);
+    x0 = first_problem.staircase().Round(Y0);
+    f0 = Costs(graph, x0);
   }
-  first_problem.staircase().Report(Y0, Solution{poses0, {}});
+  first_problem.staircase().Report(Y0, x0);
   s.initial_summary = first_problem.summary();
   s.initial_time_s = Seconds(start);
-  if (max_cost <= c2 && first_problem.summary().certified()) {
+  if (within(f0, 1) && first_problem.summary().certified()) {
     // Every measurement fits the certified optimum of the whole problem:
     // accepting all of them is TLS-consistent, and this is the inlier
     // problem. (Uncertified, e.g. an inexact relaxation because a wrong
@@ -448,12 +639,13 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     s.inlier_summary = first_problem.summary();
     s.total_time_s = Seconds(start);
     s.weights_binary = true;
-    FillEdges(graph, poses0, MeasurementWeights(m, 1.0), known,
-              std::vector<char>(m, 1), c2, &s);
-    return finish(RobustSolverSummary::Status::kConverged, poses0);
+    FillEdges(graph, x0, MeasurementWeights(K, 1.0), known,
+              std::vector<char>(K, 1), c2, &s);
+    return finish(RobustSolverSummary::Status::kConverged, std::move(x0));
   }
-  const double g0 = options.gnc_threshold_fractions[0] * c2;
-  if (max_cost > g0) s.initial_mu = g0 / (2 * max_cost - g0);
+  if (!within(f0, options.gnc_threshold_fractions[0])) {
+    s.initial_mu = initial_mu(f0, options.gnc_threshold_fractions[0]);
+  }
 
   // GNC (Yang et al. 2020, Algorithm 1 with TLS) as in GTSAM's
   // GncOptimizer, from the first solve, at GNC threshold g2: weights from
@@ -467,14 +659,15 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
                      SolverOptions& solve_options, WeightedProblem& problem) {
     const auto run_start = Clock::now();
     GncRun run;
-    run.record.gnc_threshold = fraction * c2;
-    const double g2 = run.record.gnc_threshold;
-    if (max_cost <= g2) {
+    run.record.gnc_threshold = fraction * s.inlier_threshold;
+    std::vector<double> g2(K);  // GNC's thresholds.
+    for (size_t k = 0; k < K; ++k) g2[k] = fraction * c2[k];
+    if (within(f0, fraction)) {
       // Every TLS weight is 1 at any mu: GNC would solve the first problem
       // again. Its result stands for this run (consistent at c^2 >= g^2).
-      run.poses = poses0;
-      run.weights.assign(m, 1.0);
-      run.accepted.assign(m, 1);
+      run.x = x0;
+      run.weights.assign(K, 1.0);
+      run.accepted.assign(K, 1);
       run.weights_binary = true;
       run.inlier_summary = s.initial_summary;
       run.record.tls_cost = TlsCost(f0, known, c2);
@@ -483,16 +676,16 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       return run;
     }
     Eigen::MatrixXd Y = Y0;
-    run.poses = poses0;
+    run.x = x0;
     std::vector<double> f = f0;
-    run.weights.assign(m, 1.0);  // Of the last solved problem.
+    run.weights.assign(K, 1.0);  // Of the last solved problem.
     bool reported = true;        // The first solve was reported.
     std::string message;
-    double mu = g2 / (2 * max_cost - g2);
+    double mu = initial_mu(f0, fraction);
     auto surrogate = [&](double mu_k) {
       double cost = 0;
-      for (size_t k = 0; k < m; ++k) {
-        cost += known[k] ? f[k] : TlsSurrogate(f[k], mu_k, g2);
+      for (size_t k = 0; k < K; ++k) {
+        cost += known[k] ? f[k] : TlsSurrogate(f[k], mu_k, g2[k]);
       }
       return cost;
     };
@@ -524,22 +717,23 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         break;
       }
       const auto step_start = Clock::now();
-      MeasurementWeights next(m);
-      for (size_t k = 0; k < m; ++k) {
-        next[k] = known[k] ? 1.0 : TlsWeight(f[k], mu, g2);
+      MeasurementWeights next(K);
+      for (size_t k = 0; k < K; ++k) {
+        next[k] = known[k] ? 1.0 : TlsWeight(f[k], mu, g2[k]);
       }
+      KeepLandmarksObserved(graph, f, &next, 1.0);
       if (!problem.SetWeights(next, &message)) {
-        run.accepted.assign(m, 0);
-        for (size_t k = 0; k < m; ++k) run.accepted[k] = next[k] > 0.5;
+        run.accepted.assign(K, 0);
+        for (size_t k = 0; k < K; ++k) run.accepted[k] = next[k] > 0.5;
         run.weights = next;
         return disconnected("GNC step " + std::to_string(it + 1) + ": ");
       }
       run.weights = std::move(next);
       Y = ReduceRank(Y, d, r0, kRankTolerance);
       problem.staircase().Run(&Y, /*verify_at_max_rank=*/false);
-      run.poses = problem.staircase().Round(Y).poses;
+      run.x = problem.staircase().Round(Y);
       reported = false;
-      f = Costs(graph, run.poses);
+      f = Costs(graph, run.x);
       const double cost = surrogate(mu);
       const SolverSummary& solve = problem.summary();
       RobustSolverSummary::Iteration record;
@@ -573,10 +767,11 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // at 1/2), solved from the last factor with the caller's options (the
     // Staircase refers to solve_options, so it is restored in place).
     solve_options = base;
-    run.accepted.assign(m, 0);
-    for (size_t k = 0; k < m; ++k) run.accepted[k] = run.weights[k] > 0.5;
+    run.accepted.assign(K, 0);
+    for (size_t k = 0; k < K; ++k) run.accepted[k] = run.weights[k] > 0.5;
+    KeepLandmarksObserved(graph, f, &run.accepted, char{1});
     auto record = [&]() {
-      f = Costs(graph, run.poses);
+      f = Costs(graph, run.x);
       run.record.tls_cost = TlsCost(f, known, c2);
       for (char a : run.accepted) run.record.num_outliers += !a;
       run.record.certified = run.inlier_summary.certified();
@@ -599,10 +794,13 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       cut.message = run.message;
       cut.dimension = d;
       cut.num_poses = graph.num_poses;
-      const std::vector<double> costs = Costs(graph, run.poses);
-      for (size_t k = 0; k < m; ++k) {
+      cut.num_landmarks = graph.num_landmarks;
+      const std::vector<double> costs = Costs(graph, run.x);
+      for (size_t k = 0; k < K; ++k) {
         if (!run.accepted[k]) continue;
-        ++cut.num_measurements;
+        ++(k < m                               ? cut.num_measurements
+           : k < internal::PriorTerm(graph, 0) ? cut.num_landmark_measurements
+                                               : cut.num_priors);
         cut.objective += costs[k];
       }
       cut.suboptimality_bound = cut.relative_suboptimality_bound = cut.eta =
@@ -613,21 +811,19 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     bool out_of_time = false;
     // Solves the problem restricted to `set` from *Y_io (updated in place).
     auto solve_set = [&](const std::vector<char>& set, Eigen::MatrixXd* Y_io,
-                         Poses* poses) {
-      MeasurementWeights binary(m);
-      for (size_t k = 0; k < m; ++k) binary[k] = set[k] ? 1.0 : 0.0;
+                         Solution* x_out) {
+      MeasurementWeights binary(K);
+      for (size_t k = 0; k < K; ++k) binary[k] = set[k] ? 1.0 : 0.0;
       if (!problem.SetWeights(binary, &message)) return false;
       *Y_io = ReduceRank(*Y_io, d, r0, kRankTolerance);
       problem.staircase().Run(Y_io);
       Solution x = problem.staircase().Round(*Y_io);
       problem.staircase().Continue(Y_io, &x);
-      *poses = std::move(x.poses);
+      *x_out = std::move(x);
       reported = false;
       return true;
     };
-    auto solve_accepted = [&]() {
-      return solve_set(run.accepted, &Y, &run.poses);
-    };
+    auto solve_accepted = [&]() { return solve_set(run.accepted, &Y, &run.x); };
     // Always a new solve, with the caller's options: the last GNC step
     // stopped at its own gradient tolerance and proved in double (with
     // max_iterations 0: the first solve stopped at initial_max_rank). From
@@ -641,15 +837,14 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // lowers the accepted sum), so the rounds end.
     auto make_consistent = [&]() {
       for (int round = 0; round < options.max_consistency_rounds; ++round) {
-        f = Costs(graph, run.poses);
-        std::vector<char> next = run.accepted;
-        bool changed = false;
-        for (size_t k = 0; k < m; ++k) {
-          if (known[k] || next[k] == (f[k] <= c2)) continue;
-          next[k] = f[k] <= c2;
-          changed = true;
+        f = Costs(graph, run.x);
+        std::vector<char> next(K);
+        for (size_t k = 0; k < K; ++k) {
+          next[k] = known[k] ? run.accepted[k] : f[k] <= c2[k];
         }
-        if (!changed) return true;
+        LandmarkConsensus(graph, run.x, c2, &next);
+        KeepLandmarksObserved(graph, f, &next, char{1});
+        if (next == run.accepted) return true;
         if (!budget(solve_options)) {
           out_of_time = true;
           return true;
@@ -672,12 +867,12 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // (readmission_min_scale). A rejected trial leaves the problem holding
     // it; the accepted set's optimum is solved again at the end (from its
     // factor: one more verification).
-    std::vector<char> tried(m, 0);
+    std::vector<char> tried(K, 0);
     bool restore = false;
     // The accepted set's report, for a restore the time limit prevents.
     SolverSummary accepted_summary;
     auto report_accepted = [&]() {
-      problem.staircase().Report(Y, Solution{run.poses, {}});
+      problem.staircase().Report(Y, run.x);
       reported = true;
       accepted_summary = problem.summary();
     };
@@ -690,30 +885,29 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     auto accepted_sum = [&](const std::vector<double>& costs,
                             const std::vector<char>& set) {
       double sum = 0;
-      for (size_t k = 0; k < m; ++k) sum += set[k] ? costs[k] : 0.0;
+      for (size_t k = 0; k < K; ++k) sum += set[k] ? costs[k] : 0.0;
       return sum;
     };
     for (int trial = 0; trial < options.max_readmission_trials; ++trial) {
-      f = Costs(graph, run.poses);
+      f = Costs(graph, run.x);
       // The accepted set's a-posteriori variance factor at its optimum:
-      // its cost over its redundancy (d(d+1)/2 per measurement beyond a
-      // spanning tree).
+      // its cost over its redundancy (the accepted terms' degrees of
+      // freedom beyond the unknowns': d(d+1)/2 per measurement beyond a
+      // spanning tree in a pose graph).
       const double accepted_cost = accepted_sum(f, run.accepted);
       const double redundancy =
-          d * (d + 1) / 2.0 *
-          (std::count(run.accepted.begin(), run.accepted.end(), 1) -
-           graph.num_poses + 1.0);
+          static_cast<double>(accepted_dofs(run.accepted) - unknown_dofs);
       const double scale = redundancy > 0
                                ? std::clamp(accepted_cost / redundancy,
                                             options.readmission_min_scale, 1.0)
                                : 1.0;
       int candidate = -1;
-      for (size_t k = 0; k < m; ++k) {
+      for (size_t k = 0; k < K; ++k) {
         if (run.accepted[k] || known[k] || tried[k] ||
-            !(f[k] <= options.readmission_max_cost * c2)) {
+            !(f[k] <= options.readmission_max_cost * c2[k])) {
           continue;
         }
-        if (candidate < 0 || f[k] < f[candidate]) {
+        if (candidate < 0 || f[k] / c2[k] < f[candidate] / c2[candidate]) {
           candidate = static_cast<int>(k);
         }
       }
@@ -727,20 +921,20 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       std::vector<char> set = run.accepted;
       set[candidate] = 1;
       Eigen::MatrixXd Y_trial = Y;
-      Poses poses_trial;
+      Solution x_trial;
       // Adding a measurement cannot disconnect the accepted graph.
-      if (!solve_set(set, &Y_trial, &poses_trial)) {
+      if (!solve_set(set, &Y_trial, &x_trial)) {
         return disconnected("re-admission trial: ");
       }
-      const std::vector<double> f_trial = Costs(graph, poses_trial);
+      const std::vector<double> f_trial = Costs(graph, x_trial);
       const double rise = accepted_sum(f_trial, set) - accepted_cost;
       // (A trial cut short by the time limit is not kept.)
       if (problem.summary().status != SolverSummary::Status::kTimeLimit &&
           TlsCost(f_trial, known, c2) < TlsCost(f, known, c2) &&
-          rise < scale * c2) {
+          rise < scale * c2[candidate]) {
         run.accepted = std::move(set);
         Y = std::move(Y_trial);
-        run.poses = std::move(poses_trial);
+        run.x = std::move(x_trial);
         ++run.record.readmissions;
         restore = false;
         if (!make_consistent()) return disconnected("");
@@ -751,14 +945,14 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     }
     if (restore && !budget(solve_options)) {
       // No time to solve the accepted set again: its last report stands
-      // (run.poses and Y are still its optimum).
+      // (run.x and Y are still its optimum).
       out_of_time = true;
       run.inlier_summary = accepted_summary;
     } else {
       if (restore && !solve_accepted()) {
         return disconnected("the accepted measurements: ");
       }
-      if (!reported) problem.staircase().Report(Y, Solution{run.poses, {}});
+      if (!reported) problem.staircase().Report(Y, run.x);
       run.inlier_summary = problem.summary();
     }
     if (out_of_time) {
@@ -901,8 +1095,8 @@ Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.weights_binary = best.weights_binary;
   s.message = best.message;
   s.inlier_summary = best.inlier_summary;
-  FillEdges(graph, best.poses, best.weights, known, best.accepted, c2, &s);
-  return finish(best.status, std::move(best.poses));
+  FillEdges(graph, best.x, best.weights, known, best.accepted, c2, &s);
+  return finish(best.status, std::move(best.x));
 }
 
 bool RobustSolverSummary::certified() const {
@@ -935,14 +1129,16 @@ std::string RobustSolverSummary::BriefReport() const {
                   StatusString().c_str(), message.c_str());
     return buf;
   }
+  const bool other_terms = num_landmark_measurements > 0 || num_priors > 0;
   std::snprintf(
       buf, sizeof(buf),
-      "SE-Sync GNC-TLS: %s after %d GNC iterations, %d of %d measurements "
+      "SE-Sync GNC-TLS: %s after %d GNC iterations, %d of %d %s "
       "rejected (c^2 = %.4g); the optimum of the problem restricted to the "
       "accepted edges is %s: %s, F = %.10g, relative suboptimality <= "
       "%.2e, %.3f s",
-      StatusString().c_str(), iterations, num_outliers, num_measurements,
-      inlier_threshold,
+      StatusString().c_str(), iterations, num_outliers,
+      num_measurements + num_landmark_measurements + num_priors,
+      other_terms ? "terms" : "measurements", inlier_threshold,
       inlier_summary.certified() ? "certified" : "NOT certified",
       inlier_summary.StatusString().c_str(), inlier_summary.objective,
       inlier_summary.relative_suboptimality_bound, total_time_s);
@@ -962,11 +1158,20 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   line("%-34s %d\n", "Dimension", dimension);
   line("%-34s %d\n", "Poses", num_poses);
   line("%-34s %d\n", "Measurements", num_measurements);
+  if (num_landmark_measurements > 0) {
+    line("%-34s %d\n", "Landmark measurements", num_landmark_measurements);
+  }
+  if (num_priors > 0) line("%-34s %d\n", "Priors", num_priors);
   if (status == Status::kInvalidInput) {
     line("%-34s %s\n", "Error", message.c_str());
     return out;
   }
   line("%-34s %.6g\n", "TLS threshold c^2 on f_k", inlier_threshold);
+  if (num_landmark_measurements > 0 || num_priors > 0) {
+    out +=
+        "  (landmark measurements and priors: the same quantile of their "
+        "own degrees of freedom, column c_k^2 below)\n";
+  }
   out += "\nFirst solve (all weights 1: plain SE-Sync)\n";
   line("  %s\n", initial_summary.BriefReport().c_str());
   out += "\nGraduated non-convexity: runs (the lowest TLS cost is kept)\n";
@@ -998,8 +1203,16 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
          h.verification_time_s, h.time_s, status_only.StatusString().c_str());
   }
   line("%-34s %s\n", "Final weights binary", weights_binary ? "yes" : "no");
-  line("%-34s %d accepted, %d rejected\n", "Measurements", num_inliers,
-       num_outliers);
+  line("%-34s %d accepted, %d rejected\n",
+       num_landmark_measurements > 0 || num_priors > 0 ? "Terms"
+                                                       : "Measurements",
+       num_inliers, num_outliers);
+  if (num_landmark_measurements > 0 || num_priors > 0) {
+    line("%-34s %d measurements, %d landmark measurements, %d priors\n",
+         "  rejected", static_cast<int>(outlier_edges.size()),
+         static_cast<int>(outlier_landmark_measurements.size()),
+         static_cast<int>(outlier_priors.size()));
+  }
   line("%-34s %d\n", "Consistency rounds", consistency_rounds);
   line("%-34s %d (of %d trials)\n", "Re-admitted measurements", readmissions,
        selected_run >= 0 && selected_run < static_cast<int>(runs.size())
@@ -1025,15 +1238,19 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   }
   out += "\nPer-edge verdicts";
   out += all_edges ? " (all)\n" : " (rejected)\n";
-  line("  %8s %10s %10s %9s %12s %12s %12s %s\n", "edge", "vertex i",
-       "vertex j", "weight", "rot. [deg]", "trans.", "f_k", "verdict");
+  line("  %8s %8s %10s %10s %9s %12s %12s %12s %9s %s\n", "kind", "index",
+       "vertex i", "vertex j", "weight", "rot. [deg]", "trans.", "f_k", "c_k^2",
+       "verdict");
   for (size_t k = 0; k < edges.size(); ++k) {
     const Edge& e = edges[k];
     if (!all_edges && e.inlier) continue;
-    line("  %8d %10lld %10lld %9.3g %12.4g %12.4g %12.4g %s\n",
-         static_cast<int>(k), static_cast<long long>(e.vertex_i),
+    line("  %8s %8d %10lld %10lld %9.3g %12.4g %12.4g %12.4g %9.4g %s\n",
+         e.kind == Edge::Kind::kMeasurement ? "edge"
+         : e.kind == Edge::Kind::kLandmark  ? "landmark"
+                                            : "prior",
+         e.index, static_cast<long long>(e.vertex_i),
          static_cast<long long>(e.vertex_j), e.weight, e.rotation_residual_deg,
-         e.translation_residual, e.cost,
+         e.translation_residual, e.cost, e.threshold,
          e.inlier ? (e.known_inlier ? "inlier (known)" : "inlier") : "outlier");
   }
   out += "\nTime (seconds)\n";

@@ -59,6 +59,19 @@
 // solver_options.num_threads allows; the result with the lowest TLS cost is
 // returned.
 //
+// Landmarks and priors (pose_graph.h): every term is a measurement of its
+// own here, with its own weight, verdict and threshold: a landmark
+// measurement (a wrong data association) has f_k = nu ||p_l - t_i - R_i
+// z||^2, chi^2 with d degrees of freedom, and a prior (e.g. a GPS fix off
+// by multipath) kappa ||R_i - R~||_F^2 + tau ||t_i - g||^2 with d(d-1)/2
+// for its rotation plus d for its position; the default c_k^2 is the same
+// inlier_probability quantile of its own distribution. GNC, the
+// consistency rounds and re-admission treat all terms alike in units of
+// their c_k^2 (the surrogate is homogeneous in (f_k, c_k^2)). Terms that
+// would cut a landmark or the world frame off (every observation of a
+// landmark, or every prior, rejected) disconnect the problem like a
+// rejected bridge between poses (kInlierGraphDisconnected).
+//
 // What is certified, and what is not: the final SolverSummary certifies the
 // optimum of the problem restricted to the accepted edges (weights in {0, 1}
 // make the weighted problem exactly that problem; every round-off is
@@ -97,7 +110,9 @@ struct RobustSolverOptions {
 
   // TLS threshold c^2 on f_k (see the top of this file), in the units of
   // eq. (12). <= 0 (default): the inlier_probability quantile of chi^2 with
-  // d(d+1)/2 degrees of freedom (2D: 3, 3D: 6).
+  // d(d+1)/2 degrees of freedom (2D: 3, 3D: 6), and for landmark
+  // measurements and priors the quantile of their own degrees of freedom.
+  // > 0: c^2 of every term.
   double inlier_threshold = 0;
   // The probability that an inlier's f_k is below c^2 under the noise model,
   // in (0, 1). 1 - 1e-6 gives c^2 = 30.66 (2D) and 38.26 (3D). Real
@@ -308,7 +323,15 @@ struct RobustSolverSummary {
   };
   // One measurement's verdict, at the returned poses.
   struct Edge {
-    // The original vertex ids (PoseGraph::vertex_ids) of the measured poses.
+    // The term: a relative pose measurement, a landmark measurement or a
+    // prior, and its index into graph.measurements,
+    // graph.landmark_measurements or graph.priors.
+    enum class Kind { kMeasurement, kLandmark, kPrior };
+    Kind kind = Kind::kMeasurement;
+    int index = 0;
+    // The original vertex ids (PoseGraph::vertex_ids) of the measured poses;
+    // for a landmark measurement the observing pose's and the landmark's
+    // (PoseGraph::landmark_ids), for a prior its pose's (both).
     int64_t vertex_i = 0, vertex_j = 0;
     // Final GNC weight in [0, 1] before rounding (1 for known inliers).
     double weight = 1;
@@ -317,13 +340,16 @@ struct RobustSolverSummary {
     bool inlier = true;
     // Weight held at 1 by known_inliers.
     bool known_inlier = false;
-    // Angle of R~_k^T R_i^T R_j, in degrees.
+    // Angle of R~_k^T R_i^T R_j, in degrees (a prior: of R~^T R_i; 0
+    // without a rotation term).
     double rotation_residual_deg = 0;
-    // ||t_j - t_i - R_i t~_k||, in the graph's length unit.
+    // ||t_j - t_i - R_i t~_k||, in the graph's length unit (a landmark
+    // measurement: ||p_l - t_i - R_i z||; a prior: ||t_i - g||).
     double translation_residual = 0;
-    // f_k: the measurement's term of eq. (12) (compare to
-    // inlier_threshold).
+    // f_k: the term of pose_graph.h's F (compare to threshold).
     double cost = 0;
+    // Its TLS threshold c_k^2 (inlier_threshold for measurements).
+    double threshold = 0;
   };
   // One GNC step: the weighted solve that followed a weight update.
   struct Iteration {
@@ -345,8 +371,9 @@ struct RobustSolverSummary {
   // re-admission trials after GNC: status kConverged); else empty.
   std::string message;
   int dimension = 0, num_poses = 0, num_measurements = 0;
-  // c^2 used (options.inlier_threshold or the chi-square quantile), and
-  // the selected GNC run's threshold.
+  int num_landmark_measurements = 0, num_priors = 0;
+  // c^2 of the relative pose measurements (options.inlier_threshold or the
+  // chi-square quantile), and the selected GNC run's threshold on them.
   double inlier_threshold = 0;
   double gnc_threshold = 0;
   // One GNC schedule (RobustSolverOptions::gnc_threshold_fractions).
@@ -374,14 +401,19 @@ struct RobustSolverSummary {
   // Whether the selected run's final weights were binary to
   // weight_tolerance.
   bool weights_binary = false;
-  // One verdict per measurement, in the graph's order.
+  // One verdict per term: the measurements in the graph's order, then the
+  // landmark measurements, then the priors.
   std::vector<Edge> edges;
+  // Terms accepted and rejected (all kinds).
   int num_inliers = 0, num_outliers = 0;
   // Indices (into graph.measurements: for g2o files, the 0-based order of
-  // the EDGE lines) of the rejected measurements, ascending.
+  // the pose-pose EDGE lines) of the rejected measurements, ascending.
   std::vector<int> outlier_edges;
-  // Diagnostics at the returned poses: rejected measurements with f_k <=
-  // c^2, accepted ones (known inliers excepted) with f_k > c^2. Both 0 at a
+  // The same for the rejected landmark measurements
+  // (graph.landmark_measurements) and priors (graph.priors).
+  std::vector<int> outlier_landmark_measurements, outlier_priors;
+  // Diagnostics at the returned poses: rejected terms with f_k <= c_k^2,
+  // accepted ones (known inliers excepted) with f_k > c_k^2. Both 0 at a
   // TLS-consistent split.
   int num_rejected_within_threshold = 0;
   int num_accepted_beyond_threshold = 0;
@@ -432,6 +464,10 @@ double InlierThreshold(const RobustSolverOptions& options, int dimension);
 // kInvalidInput. Deterministic for given options (including num_threads).
 Poses SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
                   RobustSolverSummary* summary);
+// The same with the landmark positions too (as Solve()'s Solution
+// overload): *solution gets the poses and one position per landmark.
+void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
+                 Solution* solution, RobustSolverSummary* summary);
 
 }  // namespace ceres_sesync
 

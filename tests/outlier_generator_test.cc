@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/robust_solver.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -211,6 +213,111 @@ TEST(OutlierGenerator, InvalidRequestsAreRejected) {
   EXPECT_THAT(error, ::testing::HasSubstr("reference trajectory"));
   o.mode = OutlierOptions::Mode::kRandom;  // Needs none.
   EXPECT_TRUE(AddOutliers(broken, o, &out, nullptr, &error)) << error;
+}
+
+// Wrong associations and false fixes: counts, the input first and
+// unchanged, each wrong association a copy of a true observation moved to
+// another landmark with no pair (l, l') twice, each false fix a position
+// prior 10..40 sigma from the truth (the noiseless graph's dead reckoning is
+// the truth) with the median position tau; deterministic; errors.
+TEST(OutlierGenerator, WrongAssociationsAndFalseFixes) {
+  for (int d : {2, 3}) {
+    LandmarkGraphOptions o;
+    o.dimension = d;
+    o.num_poses = 60;
+    o.num_landmarks = 80;
+    o.world_size = 16;
+    o.gps_interval = 3;
+    o.start_prior = true;
+    o.noiseless = true;
+    PoseGraph graph, out;
+    Solution truth;
+    std::string error;
+    ASSERT_TRUE(GenerateLandmarkGraph(o, &graph, &truth, &error)) << error;
+    for (size_t q = 0; q < graph.priors.size(); ++q) {
+      graph.priors[q].tau = 1 + 2.0 * q;  // Median of the position ones.
+    }
+    std::vector<double> taus;
+    for (const PosePrior& p : graph.priors) {
+      if (p.has_position()) taus.push_back(p.tau);
+    }
+    std::sort(taus.begin(), taus.end());
+    const size_t h = taus.size() / 2;
+    const double median =
+        taus.size() % 2 ? taus[h] : 0.5 * (taus[h - 1] + taus[h]);
+    LandmarkOutlierOptions options;
+    options.landmark_fraction = 0.3;
+    options.prior_fraction = 0.5;
+    options.seed = 4;
+    std::vector<int> added_l, added_p;
+    ASSERT_TRUE(
+        AddLandmarkOutliers(graph, options, &out, &added_l, &added_p, &error))
+        << error;
+    const size_t M = graph.landmark_measurements.size();
+    const size_t P = taus.size();
+    ASSERT_EQ(added_l.size(), static_cast<size_t>(std::lround(0.3 * M / 0.7)));
+    ASSERT_EQ(added_p.size(), P);  // 0.5 / (1 - 0.5) = 1 per position prior.
+    ASSERT_EQ(out.measurements.size(), graph.measurements.size());
+    ASSERT_EQ(out.landmark_measurements.size(), M + added_l.size());
+    ASSERT_EQ(out.priors.size(), graph.priors.size() + added_p.size());
+    std::set<std::pair<int, int>> pairs;
+    for (size_t k = 0; k < added_l.size(); ++k) {
+      EXPECT_EQ(added_l[k], static_cast<int>(M + k));
+      const LandmarkMeasurement& w = out.landmark_measurements[added_l[k]];
+      // The same (i, z, nu) as a true observation of another landmark.
+      int source = -1;
+      for (size_t q = 0; q < M; ++q) {
+        const LandmarkMeasurement& t = graph.landmark_measurements[q];
+        if (t.i == w.i && t.z == w.z && t.nu == w.nu && t.l != w.l) {
+          source = t.l;
+        }
+      }
+      ASSERT_GE(source, 0) << k;
+      EXPECT_TRUE(pairs.insert({source, w.l}).second) << k;
+      // Wrong: the truth puts landmark w.l elsewhere.
+      const Pose& x = truth.poses[w.i];
+      EXPECT_GT((truth.landmarks[w.l] - x.t - x.R * w.z).norm(), 1e-6);
+    }
+    for (size_t k = 0; k < added_p.size(); ++k) {
+      EXPECT_EQ(added_p[k], static_cast<int>(graph.priors.size() + k));
+      const PosePrior& p = out.priors[added_p[k]];
+      EXPECT_FALSE(p.has_rotation());
+      EXPECT_EQ(p.tau, median);
+      const double jump = (p.t - truth.poses[p.i].t).norm() * std::sqrt(median);
+      EXPECT_GE(jump, 10 - 1e-9);
+      EXPECT_LE(jump, 40 + 1e-9);
+    }
+    // The input's terms first, unchanged.
+    for (size_t q = 0; q < M; ++q) {
+      EXPECT_EQ(out.landmark_measurements[q].l,
+                graph.landmark_measurements[q].l);
+      EXPECT_EQ(out.landmark_measurements[q].z,
+                graph.landmark_measurements[q].z);
+    }
+    EXPECT_TRUE(ValidatePoseGraph(out, &error)) << error;
+    PoseGraph again;
+    std::vector<int> again_l, again_p;
+    ASSERT_TRUE(AddLandmarkOutliers(graph, options, &again, &again_l, &again_p,
+                                    &error));
+    for (size_t q = 0; q < out.landmark_measurements.size(); ++q) {
+      EXPECT_EQ(again.landmark_measurements[q].l,
+                out.landmark_measurements[q].l);
+    }
+    for (size_t q = 0; q < out.priors.size(); ++q) {
+      EXPECT_EQ(again.priors[q].t, out.priors[q].t);
+    }
+
+    LandmarkOutlierOptions bad = options;
+    bad.landmark_fraction = 1;
+    EXPECT_FALSE(
+        AddLandmarkOutliers(graph, bad, &again, nullptr, nullptr, &error));
+    EXPECT_THAT(error, ::testing::HasSubstr("[0, 1)"));
+    PoseGraph no_priors = graph;
+    no_priors.priors.clear();
+    EXPECT_FALSE(AddLandmarkOutliers(no_priors, options, &again, nullptr,
+                                     nullptr, &error));
+    EXPECT_THAT(error, ::testing::HasSubstr("position priors"));
+  }
 }
 
 }  // namespace

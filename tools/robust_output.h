@@ -18,15 +18,20 @@ bool ParseKnownInliers(const std::string& name,
 // Adds to the solve's JSON: "robust": true, "robust_status",
 // "inlier_threshold", "gnc_iterations", "consistency_rounds", "readmissions",
 // "num_inliers", "num_outliers", "outlier_edges" (0-based indices of the
-// rejected measurements in the order of the file's EDGE lines) and "edges"
-// (one object per measurement: weight, inlier, known_inlier,
-// rotation_residual_deg, translation_residual, cost).
+// rejected measurements in the order of the file's pose-pose EDGE lines),
+// with landmarks or priors "outlier_landmark_measurements" and
+// "outlier_priors" (0-based, in the order of the file's landmark and prior
+// EDGE lines), and "edges" (one object per term, measurements first:
+// kind (measurement|landmark|prior), index, weight, inlier, known_inlier,
+// rotation_residual_deg, translation_residual, cost, threshold).
 void AddRobustJson(const RobustSolverSummary& summary,
                    internal::JsonWriter* json);
 
-// Writes the per-edge verdicts as CSV (header line, then one line per
-// measurement in file order): edge,vertex_i,vertex_j,weight,inlier,
-// known_inlier,rotation_residual_deg,translation_residual,cost. Atomic.
+// Writes the per-edge verdicts as CSV (header line, then one line per term:
+// the measurements in file order, then the landmark measurements, then the
+// priors): edge,vertex_i,vertex_j,weight,inlier,known_inlier,
+// rotation_residual_deg,translation_residual,cost,kind,index,threshold
+// (edge: the line's term number; index: within its kind). Atomic.
 bool WriteEdgeReport(const std::string& path,
                      const RobustSolverSummary& summary, std::string* error);
 

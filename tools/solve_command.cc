@@ -276,7 +276,7 @@ int RunSolve(const Args& args) {
     robust_options.solver_options = options;
     // --max_time limits the whole command, not each of its solves.
     robust_options.max_time_s = options.max_time_s;
-    solution.poses = SolveRobust(graph, robust_options, &robust);
+    SolveRobust(graph, robust_options, &solution, &robust);
     if (progress) progress->Finish();
     std::cout << robust.FullReport() << std::flush;
     if (robust.status == RobustSolverSummary::Status::kInvalidInput) {

@@ -48,7 +48,7 @@ struct ComponentsResult : ComponentsSummary {
 };
 
 struct RobustResult : RobustSolverSummary {
-  py::object rotations, translations;
+  py::object rotations, translations, landmarks;
 };
 
 struct Measurements {
@@ -1022,6 +1022,13 @@ void BindRobust(py::module_& m) {
                     "status is the string of StatusString().");
   py::class_<S::Edge> edge(cls, "Edge", "RobustSolverSummary::Edge");
   Fields(edge)
+      .get("kind",
+           [](const S::Edge& e) {
+             return e.kind == S::Edge::Kind::kMeasurement ? "measurement"
+                    : e.kind == S::Edge::Kind::kLandmark  ? "landmark"
+                                                          : "prior";
+           })
+      .ro("index", &S::Edge::index)
       .ro("vertex_i", &S::Edge::vertex_i)
       .ro("vertex_j", &S::Edge::vertex_j)
       .ro("weight", &S::Edge::weight)
@@ -1029,7 +1036,8 @@ void BindRobust(py::module_& m) {
       .ro("known_inlier", &S::Edge::known_inlier)
       .ro("rotation_residual_deg", &S::Edge::rotation_residual_deg)
       .ro("translation_residual", &S::Edge::translation_residual)
-      .ro("cost", &S::Edge::cost);
+      .ro("cost", &S::Edge::cost)
+      .ro("threshold", &S::Edge::threshold);
   py::class_<S::Iteration> iteration(cls, "Iteration",
                                      "RobustSolverSummary::Iteration");
   Fields(iteration)
@@ -1065,6 +1073,8 @@ void BindRobust(py::module_& m) {
       .ro("dimension", &S::dimension)
       .ro("num_poses", &S::num_poses)
       .ro("num_measurements", &S::num_measurements)
+      .ro("num_landmark_measurements", &S::num_landmark_measurements)
+      .ro("num_priors", &S::num_priors)
       .ro("inlier_threshold", &S::inlier_threshold)
       .ro("gnc_threshold", &S::gnc_threshold)
       .ro("runs", &S::runs)
@@ -1078,6 +1088,12 @@ void BindRobust(py::module_& m) {
       .ro("num_outliers", &S::num_outliers)
       .get("outlier_edges",
            [](const S& s) { return IndexArray(s.outlier_edges); })
+      .get("outlier_landmark_measurements",
+           [](const S& s) {
+             return IndexArray(s.outlier_landmark_measurements);
+           })
+      .get("outlier_priors",
+           [](const S& s) { return IndexArray(s.outlier_priors); })
       .ro("num_rejected_within_threshold", &S::num_rejected_within_threshold)
       .ro("num_accepted_beyond_threshold", &S::num_accepted_beyond_threshold)
       .ro("initial_summary", &S::initial_summary)
@@ -1104,7 +1120,9 @@ void BindRobust(py::module_& m) {
       .ro("rotations", &RobustResult::rotations,
           "(n, d, d) rotations of the inlier problem's solution")
       .ro("translations", &RobustResult::translations,
-          "(n, d) translations of the inlier problem's solution");
+          "(n, d) translations of the inlier problem's solution")
+      .ro("landmarks", &RobustResult::landmarks,
+          "(L, d) landmark positions of the inlier problem's solution");
   // The inlier problem's numbers under the names solve() returns them
   // (certified and status stay RobustSolverSummary's: the inlier problem's
   // certificate, and GNC's outcome).
@@ -1148,16 +1166,18 @@ void BindRobust(py::module_& m) {
         [](const PoseGraph& graph, RobustSolverOptions options) {
           MakeInterruptible(&options.solver_options);
           RobustResult result;
-          Poses poses;
+          Solution solution;
           {
             py::gil_scoped_release release;
-            poses = SolveRobust(graph, options, &result);
+            SolveRobust(graph, options, &solution, &result);
           }
           if (result.status == RobustSolverSummary::Status::kInvalidInput) {
             InputError(result.message);
           }
-          result.rotations = RotationsArray(poses, graph.dimension);
-          result.translations = TranslationsArray(poses, graph.dimension);
+          const int d = graph.dimension;
+          result.rotations = RotationsArray(solution.poses, d);
+          result.translations = TranslationsArray(solution.poses, d);
+          result.landmarks = LandmarksArray(solution.landmarks, d);
           return result;
         });
 }
