@@ -4,6 +4,7 @@
 // inlier problem's certificate, and bad options fail with exit 2 and no
 // output file.
 
+#include <algorithm>
 #include <cstdio>  // std::remove
 #include <fstream>
 #include <sstream>
@@ -159,6 +160,62 @@ TEST(RobustCommand, BadOptionsFailWithoutOutput) {
     EXPECT_FALSE(FileExists(out + ".outliers.txt")) << args;
   }
   std::remove(clean.c_str());
+}
+
+// A noiseless 3D landmark graph with GPS priors plus wrong associations
+// and false fixes, through the tools: the indices file lists them
+// ("landmark K", "prior K"), the JSON's outlier_priors are exactly the
+// false fixes, as many landmark measurements are rejected as were added
+// and all but a few of them are wrong associations (the others are ties: a
+// landmark one pose alone observes truly is fit as well by one wrong
+// association); the solution file has the landmarks.
+TEST(RobustCommand, WrongAssociationsAndFalseFixesThroughTheTools) {
+  if (!test_util::ToolBuilt()) GTEST_SKIP() << "the tool is not built";
+  const std::string clean = TempPath("lm_clean.g2o");
+  const std::string corrupted = TempPath("lm_corrupted.g2o");
+  const std::string indices = TempPath("lm_indices.txt");
+  const std::string json = TempPath("lm_robust.json");
+  const std::string solution = TempPath("lm_solution.g2o");
+  ASSERT_EQ(RunTool("generate landmarks --dimension 3 --num_poses 200 "
+                    "--num_landmarks 150 --world_size 16 --gps_interval 10 "
+                    "--start_prior --landmark_nu 400 --noiseless --seed 2 "
+                    "--output " +
+                    clean),
+            0);
+  ASSERT_EQ(RunTool("generate outliers " + clean +
+                    " --landmark_fraction 0.3 --prior_fraction 0.3 --seed 5 "
+                    "--output " +
+                    corrupted + " --outlier_indices " + indices),
+            0);
+  std::vector<int> landmarks, priors;
+  {
+    std::ifstream in(indices);
+    std::string kind;
+    for (int k; in >> kind >> k;) {
+      (kind == "landmark" ? landmarks : priors).push_back(k);
+      EXPECT_TRUE(kind == "landmark" || kind == "prior") << kind;
+    }
+  }
+  ASSERT_GT(landmarks.size(), 100u);
+  ASSERT_GT(priors.size(), 3u);
+  ASSERT_EQ(RunTool("solve " + corrupted + " --robust --json " + json +
+                    " --output " + solution),
+            0);
+  const std::string text = ReadFile(json);
+  EXPECT_NE(text.find("\"certified\": true"), std::string::npos);
+  EXPECT_EQ(JsonInts(text, "outlier_priors"), priors);
+  EXPECT_TRUE(JsonInts(text, "outlier_edges").empty());
+  const std::vector<int> rejected =
+      JsonInts(text, "outlier_landmark_measurements");
+  EXPECT_EQ(rejected.size(), landmarks.size());
+  int rejected_wrong = 0;
+  for (int k : rejected) {
+    rejected_wrong += std::count(landmarks.begin(), landmarks.end(), k);
+  }
+  // At most a few ties (here 3 of the 378).
+  EXPECT_GE(rejected_wrong, static_cast<int>(landmarks.size()) - 5);
+  const std::string written = ReadFile(solution);
+  EXPECT_NE(written.find("VERTEX_TRACKXYZ"), std::string::npos);
 }
 
 }  // namespace

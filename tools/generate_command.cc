@@ -58,10 +58,19 @@ DEFINE_string(mode, "random",
               "closures: perceptual aliasing).");
 DEFINE_int32(cluster_size, 10,
              "generate outliers --mode clustered: wrong closures per group.");
+DEFINE_double(landmark_fraction, 0,
+              "generate outliers: fraction of the output's landmark "
+              "measurements that are wrong data associations (a true "
+              "observation attributed to another landmark), in [0, 1).");
+DEFINE_double(prior_fraction, 0,
+              "generate outliers: fraction of the output's position priors "
+              "that are false fixes (10-40 sigma jumps), in [0, 1).");
 DEFINE_string(outlier_indices, "",
               "generate outliers: where to write the 0-based indices of the "
               "added measurements, one per line, in the order of the "
-              "output's EDGE lines (default: OUTPUT.outliers.txt).");
+              "output's EDGE lines; added landmark measurements as "
+              "'landmark K', priors as 'prior K' (K in the order of their "
+              "own lines). Default: OUTPUT.outliers.txt.");
 
 namespace ceres_sesync::tools {
 
@@ -76,9 +85,10 @@ constexpr char kUsage[] =
     "[--loop_closure_probability P] [--kappa K] [--tau T] [--seed N] "
     "--output FILE.g2o [--ground_truth FILE.g2o] "
     "[--vertices odometry|ground_truth|none]\n"
-    "       ceres_sesync generate outliers GRAPH.g2o --fraction F "
-    "[--mode random|clustered] [--cluster_size K] [--seed N] --output "
-    "FILE.g2o [--outlier_indices FILE.txt]\n";
+    "       ceres_sesync generate outliers GRAPH.g2o [--fraction F] "
+    "[--mode random|clustered] [--cluster_size K] [--landmark_fraction F] "
+    "[--prior_fraction F] [--seed N] --output FILE.g2o "
+    "[--outlier_indices FILE.txt]\n";
 
 // Whether `flag` was given on the command line.
 bool IsSet(const char* flag) {
@@ -117,9 +127,23 @@ int RunGenerateOutliers(const Args& args) {
                         " is not an option of 'generate outliers'");
     }
   }
-  if (!IsSet("fraction")) return UsageError("--fraction F is required");
-  if (!(FLAGS_fraction >= 0 && FLAGS_fraction < 1)) {
+  const bool closures = IsSet("fraction");
+  const bool landmark_terms =
+      IsSet("landmark_fraction") || IsSet("prior_fraction");
+  if (!closures && !landmark_terms) {
+    return UsageError(
+        "--fraction F (wrong loop closures), --landmark_fraction F or "
+        "--prior_fraction F is required");
+  }
+  if (closures && !(FLAGS_fraction >= 0 && FLAGS_fraction < 1)) {
     return UsageError("--fraction must be in [0, 1)");
+  }
+  for (double f : {FLAGS_landmark_fraction, FLAGS_prior_fraction}) {
+    if (!(f >= 0 && f < 1)) {
+      return UsageError(
+          "--landmark_fraction and --prior_fraction must be in "
+          "[0, 1)");
+    }
   }
   if (FLAGS_output.empty()) return UsageError("--output FILE.g2o is required");
   OutlierOptions options;
@@ -143,17 +167,36 @@ int RunGenerateOutliers(const Args& args) {
     std::fprintf(stderr, "ceres_sesync generate: %s\n", error.c_str());
     return kUsageOrInputError;
   }
-  std::vector<int> added;
-  if (!AddOutliers(graph, options, &corrupted, &added, &error)) {
-    std::fprintf(stderr, "ceres_sesync generate: %s: %s\n", args[1].c_str(),
-                 error.c_str());
-    return kUsageOrInputError;
+  std::vector<int> added, added_l, added_p;
+  if (closures) {
+    if (!AddOutliers(graph, options, &corrupted, &added, &error)) {
+      std::fprintf(stderr, "ceres_sesync generate: %s: %s\n", args[1].c_str(),
+                   error.c_str());
+      return kUsageOrInputError;
+    }
+  } else {
+    corrupted = graph;
+  }
+  if (landmark_terms) {
+    LandmarkOutlierOptions landmark_options;
+    landmark_options.landmark_fraction = FLAGS_landmark_fraction;
+    landmark_options.prior_fraction = FLAGS_prior_fraction;
+    landmark_options.seed = FLAGS_seed;
+    const PoseGraph with_closures = corrupted;
+    if (!AddLandmarkOutliers(with_closures, landmark_options, &corrupted,
+                             &added_l, &added_p, &error)) {
+      std::fprintf(stderr, "ceres_sesync generate: %s: %s\n", args[1].c_str(),
+                   error.c_str());
+      return kUsageOrInputError;
+    }
   }
   const std::string indices_path = FLAGS_outlier_indices.empty()
                                        ? FLAGS_output + ".outliers.txt"
                                        : FLAGS_outlier_indices;
   std::string indices;
   for (int k : added) indices += std::to_string(k) + "\n";
+  for (int k : added_l) indices += "landmark " + std::to_string(k) + "\n";
+  for (int k : added_p) indices += "prior " + std::to_string(k) + "\n";
   if (!internal::WriteFileAtomically(indices_path, indices, &error)) {
     std::fprintf(stderr, "ceres_sesync generate: %s\n", error.c_str());
     return kUsageOrInputError;
@@ -164,13 +207,24 @@ int RunGenerateOutliers(const Args& args) {
     return kUsageOrInputError;
   }
   const int m = static_cast<int>(graph.measurements.size());
-  std::printf(
-      "outliers (%s): %d wrong loop closures appended to the %d measurements "
-      "of %s (fraction %.3g of the loop closures), seed %llu\n"
-      "wrote %s and %s\n",
-      FLAGS_mode.c_str(), static_cast<int>(added.size()), m, args[1].c_str(),
-      options.fraction, static_cast<unsigned long long>(options.seed),
-      FLAGS_output.c_str(), indices_path.c_str());
+  if (closures) {
+    std::printf(
+        "outliers (%s): %d wrong loop closures appended to the %d "
+        "measurements of %s (fraction %.3g of the loop closures), seed "
+        "%llu\n",
+        FLAGS_mode.c_str(), static_cast<int>(added.size()), m, args[1].c_str(),
+        options.fraction, static_cast<unsigned long long>(options.seed));
+  }
+  if (landmark_terms) {
+    std::printf(
+        "outliers: %d wrong landmark associations and %d false position "
+        "fixes appended to the %zu landmark measurements and %zu priors of "
+        "%s, seed %llu\n",
+        static_cast<int>(added_l.size()), static_cast<int>(added_p.size()),
+        graph.landmark_measurements.size(), graph.priors.size(),
+        args[1].c_str(), static_cast<unsigned long long>(FLAGS_seed));
+  }
+  std::printf("wrote %s and %s\n", FLAGS_output.c_str(), indices_path.c_str());
   return kSuccess;
 }
 
@@ -189,7 +243,8 @@ int RunGenerate(const Args& args) {
                       "' (cube, city, landmarks or outliers)");
   }
   for (const char* flag :
-       {"fraction", "mode", "cluster_size", "outlier_indices"}) {
+       {"fraction", "mode", "cluster_size", "outlier_indices",
+        "landmark_fraction", "prior_fraction"}) {
     if (IsSet(flag)) {
       return UsageError(std::string("--") + flag +
                         " is for 'generate outliers'");

@@ -63,7 +63,9 @@ DEFINE_bool(robust, false,
 DEFINE_double(inlier_threshold, 0,
               "solve --robust: TLS threshold c^2 on each measurement's term "
               "of the objective (0: the --inlier_probability quantile of "
-              "chi^2 with d(d+1)/2 degrees of freedom).");
+              "chi^2 with d(d+1)/2 degrees of freedom; landmark measurements "
+              "and priors: of their own degrees of freedom; > 0: every "
+              "term's).");
 DEFINE_double(inlier_probability,
               ceres_sesync::RobustSolverOptions().inlier_probability,
               "solve --robust: chi-square probability of the default "

@@ -161,3 +161,52 @@ def test_bad_landmark_lines_name_file_and_line(tmp_path):
     cs.write_g2o_poses(poses_only, g, r.rotations, r.translations)
     with pytest.raises(ValueError, match=f"^{poses_only}:.*no VERTEX line for landmark"):
         cs.read_g2o_solution(poses_only, g)
+
+
+def test_robust_solve_rejects_false_fixes_and_wrong_associations(tmp_path):
+    """solve(robust=True) on a landmark graph with wrong associations and
+    false GPS fixes made by the ceres_sesync program: the false fixes are
+    exactly outlier_priors, the landmark rejections are as many as the wrong
+    associations, and the inlier problem's objective is F of the accepted
+    terms, evaluated here with numpy."""
+    clean, bad = tmp_path / "clean.g2o", tmp_path / "bad.g2o"
+    run = run_tool("generate", "landmarks", "--dimension", 3, "--num_poses", 200,
+                   "--num_landmarks", 150, "--world_size", 16, "--gps_interval", 10,
+                   "--start_prior", "--landmark_nu", 400, "--noiseless", "--seed", 2,
+                   "--output", clean)
+    assert run.returncode == 0, run.stderr
+    run = run_tool("generate", "outliers", clean, "--landmark_fraction", 0.3,
+                   "--prior_fraction", 0.3, "--seed", 5, "--output", bad)
+    assert run.returncode == 0, run.stderr
+    kinds = [line.split() for line in open(f"{bad}.outliers.txt")]
+    wrong = [int(k) for kind, k in kinds if kind == "landmark"]
+    fixes = [int(k) for kind, k in kinds if kind == "prior"]
+    g = cs.read_g2o(str(bad))
+    rr = cs.solve(g, robust=True)
+    assert rr.certified, rr.summary
+    assert list(rr.outlier_priors) == fixes
+    assert len(rr.outlier_edges) == 0
+    assert len(rr.outlier_landmark_measurements) == len(wrong)
+    assert rr.num_landmark_measurements == len(g.landmark_measurements["i"])
+    assert rr.landmarks.shape == (g.num_landmarks, 3)
+    kind = np.array([e.kind for e in rr.edges])
+    assert set(kind) == {"measurement", "landmark", "prior"}
+    # F of the accepted terms at the result, with numpy.
+    R, t, p = rr.rotations, rr.translations, rr.landmarks
+    ms, lm, pr = g.measurements, g.landmark_measurements, g.priors
+    inlier = rr.inliers
+    m, M = len(ms.i), len(lm["i"])
+    keep = inlier[:m]
+    f = objective(ms.i[keep], ms.j[keep], ms.R[keep], ms.t[keep], ms.kappa[keep],
+                  ms.tau[keep], R, t)
+    keep = inlier[m:m + M]
+    i, l = lm["i"][keep], lm["l"][keep]
+    r = p[l] - t[i] - np.einsum("kab,kb->ka", R[i], lm["z"][keep])
+    f += float(np.sum(lm["nu"][keep] * np.sum(r**2, axis=1)))
+    for k in np.flatnonzero(inlier[m + M:]):
+        i = pr["i"][k]
+        if pr["kappa"][k] > 0:
+            f += pr["kappa"][k] * float(np.sum((R[i] - pr["R"][k]) ** 2))
+        if pr["tau"][k] > 0:
+            f += pr["tau"][k] * float(np.sum((t[i] - pr["t"][k]) ** 2))
+    assert f == pytest.approx(rr.objective, rel=1e-9, abs=1e-9)
