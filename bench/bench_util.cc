@@ -199,4 +199,35 @@ bool RunInChildProcess(double timeout_s, double max_memory_gb,
   return false;
 }
 
+std::vector<LandmarkCase> LandmarkCases(bool quick) {
+  const int n = quick ? 300 : 2000;
+  std::vector<LandmarkCase> cases;
+  LandmarkGraphOptions m2;
+  m2.dimension = 2;
+  m2.num_poses = n;
+  m2.world_size = 40;
+  m2.num_landmarks = 400;
+  m2.sensor_range = 5;
+  m2.seed = 1;
+  cases.push_back({"manhattan2d", m2});
+  LandmarkGraphOptions g2 = m2;
+  g2.gps_interval = 20;
+  g2.start_prior = true;
+  cases.push_back({"manhattan2d_gps", g2});
+  LandmarkGraphOptions m3 = m2;
+  m3.dimension = 3;
+  m3.world_size = 20;
+  m3.num_landmarks = 600;
+  cases.push_back({"manhattan3d", m3});
+  LandmarkGraphOptions g3 = m3;
+  g3.gps_interval = 20;
+  g3.start_prior = true;
+  cases.push_back({"manhattan3d_gps", g3});
+  LandmarkGraphOptions v = VictoriaParkLikeOptions();
+  v.seed = 1;
+  if (quick) v.num_poses = n;
+  cases.push_back({"victoria", v});
+  return cases;
+}
+
 }  // namespace ceres_sesync::bench

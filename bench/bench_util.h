@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "ceres_sesync/ceres_baseline.h"
+#include "ceres_sesync/landmark_generator.h"
 
 namespace ceres_sesync::bench {
 
@@ -78,6 +79,15 @@ std::string BlasLibrary();
 // How a Ceres solve ended: converged, timeout, max_iterations,
 // no_convergence, or Ceres's termination type.
 std::string CeresStatus(const CeresBaselineSummary& summary);
+
+// The generated landmark maps of the landmark benches (bench/landmarks.cc
+// documents them): manhattan2d, manhattan2d_gps, manhattan3d,
+// manhattan3d_gps, victoria; 300 poses each when `quick`, else 2000.
+struct LandmarkCase {
+  std::string name;
+  LandmarkGraphOptions options;
+};
+std::vector<LandmarkCase> LandmarkCases(bool quick);
 
 }  // namespace ceres_sesync::bench
 

@@ -64,33 +64,19 @@ DEFINE_string(out_dir, ".", "Directory for the outputs.");
 namespace ceres_sesync::bench {
 namespace {
 
-struct Case {
-  std::string name;
-  LandmarkGraphOptions options;
-};
-
-std::vector<Case> AllCases(bool quick) {
-  const int n = quick ? 300 : 2000;
-  LandmarkGraphOptions m2;
-  m2.dimension = 2;
-  m2.num_poses = n;
-  m2.world_size = 40;
-  m2.num_landmarks = 400;
-  m2.sensor_range = 5;
-  m2.gps_interval = 20;
-  m2.start_prior = true;
-  m2.seed = 1;
-  LandmarkGraphOptions m3 = m2;
-  m3.dimension = 3;
-  m3.world_size = 20;
-  m3.num_landmarks = 600;
-  LandmarkGraphOptions v = VictoriaParkLikeOptions();
-  v.num_poses = quick ? n : v.num_poses;
-  v.gps_interval = 20;
-  v.start_prior = true;
-  v.seed = 1;
-  return {
-      {"manhattan2d_gps", m2}, {"manhattan3d_gps", m3}, {"victoria_gps", v}};
+// The landmark bench's maps with priors, and its Victoria-Park-like map
+// with the same GPS priors and start prior.
+std::vector<LandmarkCase> AllCases(bool quick) {
+  std::vector<LandmarkCase> cases;
+  for (LandmarkCase c : LandmarkCases(quick)) {
+    if (c.name == "victoria") {
+      c.name = "victoria_gps";
+      c.options.gps_interval = 20;
+      c.options.start_prior = true;
+    }
+    if (c.options.gps_interval > 0) cases.push_back(c);
+  }
+  return cases;
 }
 
 struct Rates {
@@ -130,7 +116,7 @@ Rates Count(const std::vector<int>& added, const std::vector<int>& rejected) {
 }
 
 int Main() {
-  std::vector<Case> cases;
+  std::vector<LandmarkCase> cases;
   const std::set<std::string> wanted = [] {
     std::set<std::string> names;
     std::string item;
@@ -144,7 +130,7 @@ int Main() {
     }
     return names;
   }();
-  for (const Case& c : AllCases(FLAGS_quick)) {
+  for (const LandmarkCase& c : AllCases(FLAGS_quick)) {
     if (wanted.count(c.name)) cases.push_back(c);
   }
   if (cases.size() != wanted.size()) {
@@ -187,7 +173,7 @@ int Main() {
         "certified | time [s] | success |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
         "---|---|---|---|---|---|\n";
-  for (const Case& c : cases) {
+  for (const LandmarkCase& c : cases) {
     PoseGraph clean;
     std::string error;
     if (!GenerateLandmarkGraph(c.options, &clean, nullptr, &error)) {

@@ -90,41 +90,8 @@ using bench::Min;
 using bench::SecondsSince;
 using bench::Sum;
 
-struct Case {
-  std::string name;
-  LandmarkGraphOptions options;
-};
-
-std::vector<Case> AllCases(bool quick) {
-  const int n = quick ? 300 : 2000;
-  std::vector<Case> cases;
-  LandmarkGraphOptions m2;
-  m2.dimension = 2;
-  m2.num_poses = n;
-  m2.world_size = 40;
-  m2.num_landmarks = 400;
-  m2.sensor_range = 5;
-  m2.seed = 1;
-  cases.push_back({"manhattan2d", m2});
-  LandmarkGraphOptions g2 = m2;
-  g2.gps_interval = 20;
-  g2.start_prior = true;
-  cases.push_back({"manhattan2d_gps", g2});
-  LandmarkGraphOptions m3 = m2;
-  m3.dimension = 3;
-  m3.world_size = 20;
-  m3.num_landmarks = 600;
-  cases.push_back({"manhattan3d", m3});
-  LandmarkGraphOptions g3 = m3;
-  g3.gps_interval = 20;
-  g3.start_prior = true;
-  cases.push_back({"manhattan3d_gps", g3});
-  LandmarkGraphOptions v = VictoriaParkLikeOptions();
-  v.seed = 1;
-  if (quick) v.num_poses = n;
-  cases.push_back({"victoria", v});
-  return cases;
-}
+using Case = bench::LandmarkCase;
+using bench::LandmarkCases;
 
 struct Row {
   std::string case_name, method, init, status, certified, proof;
@@ -313,7 +280,7 @@ int main(int argc, char** argv) {
     while (std::getline(in, token, ',')) {
       if (!token.empty()) wanted.insert(token);
     }
-    for (const Case& c : AllCases(FLAGS_quick)) {
+    for (const Case& c : LandmarkCases(FLAGS_quick)) {
       if (wanted.erase(c.name)) cases.push_back(c);
     }
     if (!wanted.empty()) {
