@@ -227,6 +227,7 @@ void FillEdges(const PoseGraph& graph, const Solution& x,
       const RelativePoseMeasurement& e = graph.measurements[k];
       const Pose& a = poses[e.i];
       const Pose& b = poses[e.j];
+      edge.index = static_cast<int>(k);
       edge.vertex_i = pose_id(e.i);
       edge.vertex_j = pose_id(e.j);
       edge.rotation_residual_deg =
@@ -253,7 +254,6 @@ void FillEdges(const PoseGraph& graph, const Solution& x,
       }
       if (p.has_position()) edge.translation_residual = (a.t - p.t).norm();
     }
-    if (k < m) edge.index = static_cast<int>(k);
     edge.weight = weights.empty() ? 1.0 : weights[k];
     edge.inlier = accepted[k];
     edge.known_inlier = known[k];
@@ -656,13 +656,14 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // its first step) with `solve_options`, the options `problem` refers to,
   // and `base`, the caller's options as this run uses them.
   auto run_gnc = [&](double fraction, const SolverOptions& base,
-                     SolverOptions& solve_options, WeightedProblem& problem) {
+                     SolverOptions& solve_options, WeightedProblem& problem,
+                     const MeasurementWeights* start_set = nullptr) {
     const auto run_start = Clock::now();
     GncRun run;
     run.record.gnc_threshold = fraction * s.inlier_threshold;
     std::vector<double> g2(K);  // GNC's thresholds.
     for (size_t k = 0; k < K; ++k) g2[k] = fraction * c2[k];
-    if (within(f0, fraction)) {
+    if (start_set == nullptr && within(f0, fraction)) {
       // Every TLS weight is 1 at any mu: GNC would solve the first problem
       // again. Its result stands for this run (consistent at c^2 >= g^2).
       run.x = x0;
@@ -681,7 +682,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     run.weights.assign(K, 1.0);  // Of the last solved problem.
     bool reported = true;        // The first solve was reported.
     std::string message;
-    double mu = initial_mu(f0, fraction);
+    double mu = start_set == nullptr ? initial_mu(f0, fraction) : 0;
     auto surrogate = [&](double mu_k) {
       double cost = 0;
       for (size_t k = 0; k < K; ++k) {
@@ -711,7 +712,12 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     solve_options.max_rank = std::min(
         options.solver_options.max_rank,
         options.gnc_max_rank > 0 ? std::max(options.gnc_max_rank, r0) : r0 + 2);
-    for (int it = 0; it < options.max_iterations; ++it) {
+    if (start_set != nullptr) {  // No GNC: its accepted set is given.
+      run.weights = *start_set;
+      run.status = RobustSolverSummary::Status::kConverged;
+    }
+    for (int it = 0; start_set == nullptr && it < options.max_iterations;
+         ++it) {
       if (!budget(solve_options)) {
         run.status = RobustSolverSummary::Status::kTimeLimit;
         break;
@@ -971,8 +977,56 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // one after another; a run's problem (data matrices, factors) lives while
   // it runs. The calling thread runs the first run (SolverOptions::progress
   // is called from it alone); callbacks are serialized.
+  // Landmark graphs: one more run, without GNC, from a start that the
+  // least-squares fit of every term does not decide. The graph without its
+  // landmarks (odometry, loop closures, priors) is solved robustly first;
+  // at its poses each landmark is placed where most of its observations
+  // agree (LandmarkConsensus); the terms accepted so are the run's set,
+  // which the consistency rounds and re-admission trials then refine like
+  // a GNC run's. False if the graph without landmarks cannot be solved
+  // (e.g. its poses are connected only through landmarks).
+  auto consensus_start = [&](const SolverOptions& base,
+                             MeasurementWeights* set) {
+    PoseGraph poses_only = graph;
+    poses_only.num_landmarks = 0;
+    poses_only.landmark_measurements.clear();
+    poses_only.landmark_ids.clear();
+    poses_only.index_of_landmark_id.clear();
+    poses_only.initial_landmarks.clear();
+    RobustSolverOptions nested = options;
+    nested.solver_options = base;
+    RobustSolverSummary nested_summary;
+    Solution nested_x;
+    SolveRobust(poses_only, nested, &nested_x, &nested_summary);
+    if (nested_summary.status != RobustSolverSummary::Status::kConverged &&
+        nested_summary.status != RobustSolverSummary::Status::kMaxIterations) {
+      return false;
+    }
+    std::vector<char> accepted(K, 0);
+    for (size_t k = 0; k < m; ++k) accepted[k] = nested_summary.edges[k].inlier;
+    for (size_t q = 0; q < graph.priors.size(); ++q) {
+      accepted[internal::PriorTerm(graph, q)] =
+          nested_summary.edges[m + q].inlier;
+    }
+    // Each landmark at the precision-weighted mean of the positions its
+    // observations imply, then moved by the consensus.
+    Solution x{std::move(nested_x.poses), {}};
+    x.landmarks.assign(graph.num_landmarks, Eigen::VectorXd::Zero(d));
+    std::vector<double> weight(graph.num_landmarks, 0);
+    for (const LandmarkMeasurement& o : graph.landmark_measurements) {
+      x.landmarks[o.l] += o.nu * (x.poses[o.i].t + x.poses[o.i].R * o.z);
+      weight[o.l] += o.nu;
+    }
+    for (int l = 0; l < graph.num_landmarks; ++l) x.landmarks[l] /= weight[l];
+    LandmarkConsensus(graph, x, c2, &accepted);
+    KeepLandmarksObserved(graph, Costs(graph, x), &accepted, char{1});
+    set->assign(accepted.begin(), accepted.end());
+    return true;
+  };
+
   const auto gnc_start = Clock::now();
-  const size_t num_runs = options.gnc_threshold_fractions.size();
+  const size_t num_gnc_runs = options.gnc_threshold_fractions.size();
+  const size_t num_runs = num_gnc_runs + (graph.num_landmarks > 0 ? 1 : 0);
   const int threads =
       internal::ResolveNumThreads(options.solver_options.num_threads);
   const int workers = static_cast<int>(
@@ -1013,8 +1067,15 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     if (q == 0) first_options = base;
     SolverOptions& solve_options = own ? run_options : first_options;
     WeightedProblem& problem = own ? *own : first_problem;
-    GncRun run = run_gnc(options.gnc_threshold_fractions[q], base,
-                         solve_options, problem);
+    GncRun run;
+    if (q < num_gnc_runs) {
+      run = run_gnc(options.gnc_threshold_fractions[q], base, solve_options,
+                    problem);
+    } else {
+      MeasurementWeights start_set;
+      if (!consensus_start(base, &start_set)) return;
+      run = run_gnc(0, base, solve_options, problem, &start_set);
+    }
     run.record.status = run.status;
     run.pattern_rebuilds = problem.rebuilds();
     runs[q] = std::move(run);

@@ -131,7 +131,9 @@ const std::vector<Command>& Commands() {
        "per pose). 'generate outliers GRAPH.g2o' writes a copy of a graph "
        "with wrong loop closures appended (--fraction of all its loop "
        "closures; random, or clustered: groups of mutually consistent wrong "
-       "closures) and the indices of what it added.",
+       "closures), wrong landmark associations (--landmark_fraction) and "
+       "false position fixes (--prior_fraction), and the indices of what it "
+       "added.",
        {{"output", "Write the generated graph to this g2o file (required)."},
         {"side"},
         {"poses"},
@@ -165,6 +167,8 @@ const std::vector<Command>& Commands() {
         {"fraction"},
         {"mode"},
         {"cluster_size"},
+        {"landmark_fraction"},
+        {"prior_fraction"},
         {"outlier_indices"}}},
   };
   return commands;

@@ -51,7 +51,8 @@ DEFINE_string(vertices, "odometry",
 
 DEFINE_double(fraction, -1,
               "generate outliers: fraction of the output's loop closures that "
-              "are wrong, in [0, 1) (required).");
+              "are wrong, in [0, 1) (this, --landmark_fraction or "
+              "--prior_fraction is required).");
 DEFINE_string(mode, "random",
               "generate outliers: random (random pose pairs and relative "
               "poses) | clustered (groups of mutually consistent wrong "
