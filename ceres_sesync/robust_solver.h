@@ -262,11 +262,12 @@ struct RobustSolverOptions {
   // differs from {k : f_k <= c_k^2} at the certified optimum of the
   // accepted set's problem (landmark measurements: with their landmark
   // placed by the consensus rule at the top of this file), replace it and
-  // solve again, at most this many times (0: off). Every round lowers the TLS cost, so the result is a fixed point
-  // whenever fewer rounds suffice (then num_rejected_within_threshold and
-  // num_accepted_beyond_threshold are 0). Measured: GNC at c^2 = 100
-  // rejected 3 true closures of manhattan (30% random outliers) whose f_k at
-  // its result were below c^2; one round re-admitted them.
+  // solve again, at most this many times (0: off). Every round lowers the TLS
+  // cost, so the result is a fixed point whenever fewer rounds suffice (then
+  // num_rejected_within_threshold and num_accepted_beyond_threshold are 0).
+  // Measured: GNC at c^2 = 100 rejected 3 true closures of manhattan (30%
+  // random outliers) whose f_k at its result were below c^2; one round
+  // re-admitted them.
   int max_consistency_rounds = 10;
 
   // After the consistency rounds (not part of Yang et al.'s method either):
