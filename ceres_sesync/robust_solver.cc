@@ -995,6 +995,10 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     poses_only.initial_landmarks.clear();
     RobustSolverOptions nested = options;
     nested.solver_options = base;
+    if (options.max_time_s > 0) {  // What is left of the whole limit.
+      nested.max_time_s = options.max_time_s - Seconds(start);
+      if (!(nested.max_time_s > 0)) return false;
+    }
     RobustSolverSummary nested_summary;
     Solution nested_x;
     SolveRobust(poses_only, nested, &nested_x, &nested_summary);

@@ -80,7 +80,8 @@
 // least-squares fit of every term, which wrong associations can fold
 // beyond its reach; so a graph with landmarks gets one more run (in
 // RobustSolverSummary::runs after the GNC runs, competing by TLS cost like
-// them) that starts elsewhere: the graph without its landmarks is solved
+// them; one after another, it is the last, and a time limit can leave it
+// out) that starts elsewhere: the graph without its landmarks is solved
 // robustly, each landmark is placed where most of its observations agree
 // at those poses, and the terms accepted so are refined by the consistency
 // rounds and re-admission trials. Rejecting every prior
