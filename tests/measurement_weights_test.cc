@@ -552,8 +552,10 @@ TEST(MeasurementWeights, CutOffLandmarkOrWorldIsRejected) {
     w[internal::PriorTerm(g, q)] = g.priors[q].has_rotation() ? 1 : 0;
   }
   EXPECT_TRUE(internal::CheckMeasurementWeights(g, w, &error)) << error;
+  SolverOptions options;  // The Staircase keeps a reference.
+  options.num_threads = 1;
   SolverSummary summary;
-  internal::Staircase staircase(g, SolverOptions(), &summary,
+  internal::Staircase staircase(g, options, &summary,
                                 internal::Staircase::Clock::now(), w);
   EXPECT_TRUE(staircase.ok()) << summary.message;
   w.pop_back();

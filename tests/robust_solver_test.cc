@@ -992,16 +992,16 @@ TEST(RobustSolver,
 }
 
 // A 2D map with ~30 landmarks per pose, 30% wrong associations and 30%
-// false GPS fixes: GNC, started from the least-squares fit of every term,
-// ends with the map folded (measured: largest translation error 62 m, 852
-// true observations and 11 true fixes rejected). The consensus run (the
-// graph without landmarks solved robustly, then each landmark placed where
-// most of its observations agree) reaches a lower TLS cost, is selected,
-// and its map is the clean graph's certified optimum up to the few
-// centimeters that the remaining accepted wrong associations move it.
+// false GPS fixes: both GNC runs, started from the least-squares fit of
+// every term, end at local minima of the TLS cost (measured: 64,558, not
+// certified, and 62,729). The consensus run (the graph without landmarks
+// solved robustly, then each landmark placed where most of its
+// observations agree) reaches 54,280, is selected, and its map is the
+// clean graph's certified optimum up to the few centimeters that the
+// remaining accepted wrong associations move it.
 TEST(RobustSolver, ConsensusRunRecoversAMapThatGncFolds) {
   LandmarkGraphOptions o = VictoriaParkLikeOptions();
-  o.num_poses = 300;
+  o.num_poses = 150;
   o.gps_interval = 20;
   o.start_prior = true;
   o.seed = 1;
@@ -1011,7 +1011,7 @@ TEST(RobustSolver, ConsensusRunRecoversAMapThatGncFolds) {
   LandmarkOutlierOptions outliers;
   outliers.landmark_fraction = 0.3;
   outliers.prior_fraction = 0.3;
-  outliers.seed = 1;
+  outliers.seed = 2;
   std::vector<int> added_l, added_p;
   ASSERT_TRUE(AddLandmarkOutliers(clean, outliers, &corrupted, &added_l,
                                   &added_p, &error))
