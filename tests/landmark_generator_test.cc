@@ -412,6 +412,12 @@ TEST(GenerateLandmarksCommand, WritesTheGraphAndTheGroundTruth) {
   EXPECT_EQ(RunTool("generate landmarks --dimension 4 --output " + output), 2);
   EXPECT_EQ(RunTool("generate landmarks --sensor_range -1 --output " + output),
             2);
+  // Flags of the other models (cube, city, outliers).
+  EXPECT_EQ(RunTool("generate landmarks --side 4 --output " + output), 2);
+  EXPECT_EQ(RunTool("generate landmarks --fraction 0.1 --output " + output), 2);
+  EXPECT_EQ(
+      RunTool("generate landmarks --landmark_fraction 0.1 --output " + output),
+      2);
   EXPECT_EQ(RunTool("generate landmarks --vertices bogus --output " + output),
             2);
   EXPECT_FALSE(Exists(output)) << "a failed run left " << output;

@@ -89,6 +89,15 @@ int RunGenerateLandmarks(const Args& args) {
   if (args.size() > 1) {
     return UsageError("unexpected argument '" + args[1] + "'");
   }
+  for (const char* flag :
+       {"side", "poses", "loop_closure_probability", "loop_closure_radius",
+        "fraction", "mode", "cluster_size", "outlier_indices",
+        "landmark_fraction", "prior_fraction"}) {
+    if (!IsDefault(flag)) {
+      return UsageError(std::string("--") + flag +
+                        " is not an option of 'generate landmarks'");
+    }
+  }
   if (FLAGS_output.empty()) return UsageError("--output FILE.g2o is required");
   if (FLAGS_vertices != "odometry" && FLAGS_vertices != "ground_truth" &&
       FLAGS_vertices != "none") {
