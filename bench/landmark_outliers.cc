@@ -5,7 +5,8 @@
 //
 //   landmark_outliers [--quick] [--cases LIST] [--fractions LIST]
 //                     [--kinds both|landmarks|priors] [--seeds N]
-//                     [--num_threads N] [--mu_step X] [--out_dir DIR]
+//                     [--methods sesync,ceres] [--num_threads N]
+//                     [--mu_step X] [--out_dir DIR]
 //
 // Cases (seed 1, GPS-like position priors every 20th pose, 1 m RMS, and a
 // start prior: the solutions are in the world frame):
@@ -14,6 +15,13 @@
 //  - manhattan3d_gps: 3D walk, 2000 poses in a 20 m box, 600 landmarks;
 //  - victoria_gps:    VictoriaParkLikeOptions() (~30 landmarks per pose).
 // --quick: 300 poses per case.
+//
+// Methods (--methods): SE-Sync GNC (SolveRobust with default options), and
+// Ceres Levenberg-Marquardt with HuberLoss and with CauchyLoss on every term
+// (ceres_baseline.h; a^2 = each kind's default TLS threshold), from the
+// odometry in the priors' frame with each landmark at its first
+// observation; their verdicts are f_k > c_k^2 at their result, and they
+// certify nothing.
 //
 // Per case, fraction F and seed s: F of the output's landmark measurements
 // are wrong associations and F of its position priors false fixes
@@ -38,6 +46,8 @@
 #include <vector>
 
 #include "bench/bench_util.h"
+#include "ceres_sesync/ceres_baseline.h"
+#include "ceres_sesync/internal/chi_square.h"
 #include "ceres_sesync/landmark_generator.h"
 #include "ceres_sesync/outlier_generator.h"
 #include "ceres_sesync/robust_solver.h"
@@ -60,6 +70,10 @@ DEFINE_int32(num_threads, 1, "SolverOptions::num_threads.");
 DEFINE_double(mu_step, ceres_sesync::RobustSolverOptions().mu_step,
               "RobustSolverOptions::mu_step.");
 DEFINE_string(out_dir, ".", "Directory for the outputs.");
+DEFINE_string(methods, "sesync,ceres",
+              "sesync (SolveRobust) and/or ceres (Levenberg-Marquardt with "
+              "Huber and with Cauchy losses on every term).");
+DEFINE_double(ceres_max_time, 60, "Ceres time limit per run, seconds.");
 
 namespace ceres_sesync::bench {
 namespace {
@@ -138,6 +152,22 @@ int Main() {
     return 2;
   }
   const std::vector<double> fractions = ParseDoubles(FLAGS_fractions);
+  std::set<std::string> methods;
+  {
+    std::string item;
+    for (char ch : FLAGS_methods + ",") {
+      if (ch != ',') {
+        item += ch;
+      } else if (!item.empty()) {
+        if (item != "sesync" && item != "ceres") {
+          std::fprintf(stderr, "unknown method '%s'\n", item.c_str());
+          return 2;
+        }
+        methods.insert(item);
+        item.clear();
+      }
+    }
+  }
   if (FLAGS_kinds != "both" && FLAGS_kinds != "landmarks" &&
       FLAGS_kinds != "priors") {
     std::fprintf(stderr, "--kinds must be both, landmarks or priors\n");
@@ -151,7 +181,7 @@ int Main() {
     std::fprintf(stderr, "cannot write to %s\n", FLAGS_out_dir.c_str());
     return 2;
   }
-  csv << "case,d,n,landmarks,landmark_measurements,priors,fraction,seed,"
+  csv << "case,method,d,n,landmarks,landmark_measurements,priors,fraction,seed,"
          "wrong_associations,rejected_landmark,rejected_wrong_landmark,"
          "landmark_precision,landmark_recall,ties,false_fixes,"
          "rejected_priors,rejected_false_priors,prior_precision,"
@@ -167,12 +197,13 @@ int Main() {
         "associations accepted on landmarks one pose alone observes truly "
         "(not identifiable); errors and gap against the clean graph's "
         "certified optimum.\n\n"
-        "| case | d | n | L | M | P | F | seed | wrong | lm. precision | "
+        "| case | method | d | n | L | M | P | F | seed | wrong | lm. "
+        "precision | "
         "lm. recall | ties | fixes | prior precision | prior recall | "
         "edges rejected | max rot. err [deg] | max trans. err | clean gap | "
         "certified | time [s] | success |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-        "---|---|---|---|---|---|\n";
+        "---|---|---|---|---|---|---|\n";
   for (const LandmarkCase& c : cases) {
     PoseGraph clean;
     std::string error;
@@ -209,71 +240,149 @@ int Main() {
           std::fprintf(stderr, "%s: %s\n", c.name.c_str(), error.c_str());
           return 1;
         }
-        RobustSolverOptions robust;
-        robust.solver_options.num_threads = FLAGS_num_threads;
-        robust.mu_step = FLAGS_mu_step;
-        RobustSolverSummary s;
-        Solution x;
-        const auto start = Clock::now();
-        SolveRobust(corrupted, robust, &x, &s);
-        const double time_s = SecondsSince(start);
-        const Rates lm = Count(added_l, s.outlier_landmark_measurements);
-        const Rates pr = Count(added_p, s.outlier_priors);
-        const std::set<int> rejected(s.outlier_landmark_measurements.begin(),
-                                     s.outlier_landmark_measurements.end());
-        int ties = 0;
-        for (int q : added_l) {
-          ties += !rejected.count(q) &&
-                  seen_by[corrupted.landmark_measurements[q].l] == 1;
-        }
-        double rot = NAN, trans = NAN, gap = NAN;
-        if (x.poses.size() == optimum.poses.size()) {
-          rot = trans = 0;
-          for (size_t i = 0; i < x.poses.size(); ++i) {
-            const Eigen::MatrixXd dR =
-                optimum.poses[i].R.transpose() * x.poses[i].R;
-            const double cos_angle =
-                std::clamp((dR.trace() - (clean.dimension - 2)) / 2, -1.0, 1.0);
-            rot = std::max(rot, std::acos(cos_angle) * 180 / M_PI);
-            trans = std::max(trans, (x.poses[i].t - optimum.poses[i].t).norm());
+        // One row: a method's result x, its rejections (indices per kind)
+        // and certificate.
+        auto row = [&](const std::string& method, const Solution& x,
+                       const std::vector<int>& rejected_edges,
+                       const std::vector<int>& rejected_landmarks,
+                       const std::vector<int>& rejected_priors, bool certified,
+                       double time_s, const std::string& status) {
+          const Rates lm = Count(added_l, rejected_landmarks);
+          const Rates pr = Count(added_p, rejected_priors);
+          const std::set<int> rejected(rejected_landmarks.begin(),
+                                       rejected_landmarks.end());
+          int ties = 0;
+          for (int q : added_l) {
+            ties += !rejected.count(q) &&
+                    seen_by[corrupted.landmark_measurements[q].l] == 1;
           }
-          gap = (EvaluateObjective(clean, x.poses,
-                                   CleanLandmarks(clean, x.poses)) -
-                 clean_summary.objective) /
-                clean_summary.objective;
+          double rot = NAN, trans = NAN, gap = NAN;
+          if (x.poses.size() == optimum.poses.size()) {
+            rot = trans = 0;
+            for (size_t i = 0; i < x.poses.size(); ++i) {
+              const Eigen::MatrixXd dR =
+                  optimum.poses[i].R.transpose() * x.poses[i].R;
+              const double cos_angle = std::clamp(
+                  (dR.trace() - (clean.dimension - 2)) / 2, -1.0, 1.0);
+              rot = std::max(rot, std::acos(cos_angle) * 180 / M_PI);
+              trans =
+                  std::max(trans, (x.poses[i].t - optimum.poses[i].t).norm());
+            }
+            gap = (EvaluateObjective(clean, x.poses,
+                                     CleanLandmarks(clean, x.poses)) -
+                   clean_summary.objective) /
+                  clean_summary.objective;
+          }
+          const bool success = certified && rejected_edges.empty() &&
+                               lm.precision() >= 0.99 && lm.recall() >= 0.99 &&
+                               pr.precision() >= 0.99 && pr.recall() >= 0.99 &&
+                               gap <= 1e-6;
+          char line[1024];
+          std::snprintf(
+              line, sizeof(line),
+              "%s,%s,%d,%d,%d,%zu,%zu,%g,%d,%d,%d,%d,%.6f,%.6f,%d,%d,%d,%d,"
+              "%.6f,%.6f,%zu,%.6g,%.6g,%.6g,%d,%.4f,%d,%s\n",
+              c.name.c_str(), method.c_str(), clean.dimension, clean.num_poses,
+              clean.num_landmarks, corrupted.landmark_measurements.size(),
+              corrupted.priors.size(), fraction, seed, lm.added, lm.rejected,
+              lm.rejected_wrong, lm.precision(), lm.recall(), ties, pr.added,
+              pr.rejected, pr.rejected_wrong, pr.precision(), pr.recall(),
+              rejected_edges.size(), rot, trans, gap, certified ? 1 : 0, time_s,
+              success ? 1 : 0, status.c_str());
+          csv << line << std::flush;
+          std::snprintf(
+              line, sizeof(line),
+              "| %s | %s | %d | %d | %d | %zu | %zu | %g | %d | %d | %.4f | "
+              "%.4f | %d | %d | %.4f | %.4f | %zu | %.3g | %.3g | %.2e | %s | "
+              "%.2f | %s |\n",
+              c.name.c_str(), method.c_str(), clean.dimension, clean.num_poses,
+              clean.num_landmarks, corrupted.landmark_measurements.size(),
+              corrupted.priors.size(), fraction, seed, lm.added, lm.precision(),
+              lm.recall(), ties, pr.added, pr.precision(), pr.recall(),
+              rejected_edges.size(), rot, trans, gap, certified ? "yes" : "no",
+              time_s, success ? "yes" : "no");
+          md << line << std::flush;
+          std::printf("%s", line);
+        };
+        if (methods.count("sesync")) {
+          RobustSolverOptions robust;
+          robust.solver_options.num_threads = FLAGS_num_threads;
+          robust.mu_step = FLAGS_mu_step;
+          RobustSolverSummary s;
+          Solution x;
+          const auto start = Clock::now();
+          SolveRobust(corrupted, robust, &x, &s);
+          row("SE-Sync GNC", x, s.outlier_edges,
+              s.outlier_landmark_measurements, s.outlier_priors, s.certified(),
+              SecondsSince(start),
+              s.StatusString() + "/" + s.inlier_summary.StatusString());
         }
-        const bool success = s.certified() && s.outlier_edges.empty() &&
-                             lm.precision() >= 0.99 && lm.recall() >= 0.99 &&
-                             pr.precision() >= 0.99 && pr.recall() >= 0.99 &&
-                             gap <= 1e-6;
-        const std::string status =
-            s.StatusString() + "/" + s.inlier_summary.StatusString();
-        char line[1024];
-        std::snprintf(
-            line, sizeof(line),
-            "%s,%d,%d,%d,%zu,%zu,%g,%d,%d,%d,%d,%.6f,%.6f,%d,%d,%d,%d,%.6f,"
-            "%.6f,%zu,%.6g,%.6g,%.6g,%d,%.4f,%d,%s\n",
-            c.name.c_str(), clean.dimension, clean.num_poses,
-            clean.num_landmarks, corrupted.landmark_measurements.size(),
-            corrupted.priors.size(), fraction, seed, lm.added, lm.rejected,
-            lm.rejected_wrong, lm.precision(), lm.recall(), ties, pr.added,
-            pr.rejected, pr.rejected_wrong, pr.precision(), pr.recall(),
-            s.outlier_edges.size(), rot, trans, gap, s.certified() ? 1 : 0,
-            time_s, success ? 1 : 0, status.c_str());
-        csv << line << std::flush;
-        std::snprintf(
-            line, sizeof(line),
-            "| %s | %d | %d | %d | %zu | %zu | %g | %d | %d | %.4f | %.4f | "
-            "%d | %d | %.4f | %.4f | %zu | %.3g | %.3g | %.2e | %s | %.2f | "
-            "%s |\n",
-            c.name.c_str(), clean.dimension, clean.num_poses,
-            clean.num_landmarks, corrupted.landmark_measurements.size(),
-            corrupted.priors.size(), fraction, seed, lm.added, lm.precision(),
-            lm.recall(), ties, pr.added, pr.precision(), pr.recall(),
-            s.outlier_edges.size(), rot, trans, gap,
-            s.certified() ? "yes" : "no", time_s, success ? "yes" : "no");
-        md << line << std::flush;
-        std::printf("%s", line);
+        for (auto [name, type] :
+             {std::pair{"LM Huber", CeresRobustLoss::Type::kHuber},
+              {"LM Cauchy", CeresRobustLoss::Type::kCauchy}}) {
+          if (!methods.count("ceres")) break;
+          // From the odometry (in the priors' frame) and each landmark at
+          // its first observation; the loss's a^2 = each kind's TLS
+          // threshold; verdicts: f_k > c_k^2 at the result.
+          const auto start = Clock::now();
+          const Poses poses = OdometryInitialization(corrupted);
+          const Solution initial{poses,
+                                 InitialLandmarkPositions(corrupted, poses)};
+          const RobustSolverOptions defaults;
+          const int d = corrupted.dimension;
+          CeresBaselineOptions options;
+          options.method = CeresBaselineOptions::Method::kLevenbergMarquardt;
+          options.num_threads = FLAGS_num_threads;
+          options.max_solver_time_s = FLAGS_ceres_max_time;
+          options.loss.type = type;
+          options.loss.threshold = InlierThreshold(defaults, d);
+          options.loss.landmark_threshold =
+              internal::ChiSquareQuantile(defaults.inlier_probability, d);
+          options.loss.prior_threshold = options.loss.landmark_threshold;
+          Solution x;
+          CeresBaselineSummary summary;
+          std::string why;
+          const bool ok =
+              SolveWithCeres(corrupted, initial, options, &x, &summary, &why);
+          const double time_s = SecondsSince(start);
+          std::vector<int> edges, landmarks, priors;
+          if (ok) {
+            for (size_t k = 0; k < corrupted.measurements.size(); ++k) {
+              const RelativePoseMeasurement& e = corrupted.measurements[k];
+              const Pose& a = x.poses[e.i];
+              const Pose& b = x.poses[e.j];
+              if (e.kappa * (b.R - a.R * e.R).squaredNorm() +
+                      e.tau * (b.t - a.t - a.R * e.t).squaredNorm() >
+                  options.loss.threshold) {
+                edges.push_back(static_cast<int>(k));
+              }
+            }
+            for (size_t q = 0; q < corrupted.landmark_measurements.size();
+                 ++q) {
+              const LandmarkMeasurement& o = corrupted.landmark_measurements[q];
+              const Pose& a = x.poses[o.i];
+              if (o.nu * (x.landmarks[o.l] - a.t - a.R * o.z).squaredNorm() >
+                  options.loss.landmark_threshold) {
+                landmarks.push_back(static_cast<int>(q));
+              }
+            }
+            for (size_t q = 0; q < corrupted.priors.size(); ++q) {
+              const PosePrior& p = corrupted.priors[q];
+              const Pose& a = x.poses[p.i];
+              double f = 0;
+              if (p.has_rotation()) f += p.kappa * (a.R - p.R).squaredNorm();
+              if (p.has_position()) f += p.tau * (a.t - p.t).squaredNorm();
+              if (f > internal::ChiSquareQuantile(
+                          defaults.inlier_probability,
+                          (p.has_rotation() ? d * (d - 1) / 2 : 0) +
+                              (p.has_position() ? d : 0))) {
+                priors.push_back(static_cast<int>(q));
+              }
+            }
+          }
+          row(name, x, edges, landmarks, priors, false, time_s,
+              ok ? CeresStatus(summary) : "failed: " + why);
+        }
       }
     }
   }

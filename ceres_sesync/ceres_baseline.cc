@@ -217,9 +217,11 @@ Eigen::Matrix3d ProjectToSO3(const Eigen::Matrix3d& M) {
   return svd.matrixU() * D * svd.matrixV().transpose();
 }
 
-// The loss of `loss` (owned by the problem), or null for least squares.
-ceres::LossFunction* MakeLoss(const CeresRobustLoss& loss) {
-  const double a = std::sqrt(loss.threshold);
+// The loss of `loss`'s type with a^2 = `threshold` (owned by the problem),
+// or null for least squares (no type, or threshold 0).
+ceres::LossFunction* MakeLoss(const CeresRobustLoss& loss, double threshold) {
+  if (!(threshold > 0)) return nullptr;
+  const double a = std::sqrt(threshold);
   switch (loss.type) {
     case CeresRobustLoss::Type::kNone:
       return nullptr;
@@ -344,6 +346,11 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
       !(loss.threshold > 0 && std::isfinite(loss.threshold))) {
     return fail("a robust loss needs a positive finite threshold");
   }
+  if (!(loss.landmark_threshold >= 0 &&
+        std::isfinite(loss.landmark_threshold)) ||
+      !(loss.prior_threshold >= 0 && std::isfinite(loss.prior_threshold))) {
+    return fail("landmark and prior loss thresholds must be finite and >= 0");
+  }
   for (int i = 0; i < n; ++i) {
     problem->AddParameterBlock(blocks->translation(i), d);
     if (d == 2) {
@@ -365,9 +372,9 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
       cost = new ceres::AutoDiffCostFunction<Pose3Residual, 12, 3, 4, 3, 4>(
           new Pose3Residual(m));
     }
-    problem->AddResidualBlock(cost, MakeLoss(loss), blocks->translation(m.i),
-                              blocks->rotation(m.i), blocks->translation(m.j),
-                              blocks->rotation(m.j));
+    problem->AddResidualBlock(cost, MakeLoss(loss, loss.threshold),
+                              blocks->translation(m.i), blocks->rotation(m.i),
+                              blocks->translation(m.j), blocks->rotation(m.j));
   }
   for (const LandmarkMeasurement& m : graph.landmark_measurements) {
     ceres::CostFunction* cost;
@@ -378,8 +385,9 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
       cost = new ceres::AutoDiffCostFunction<LandmarkResidual<3>, 3, 3, 4, 3>(
           new LandmarkResidual<3>(m));
     }
-    problem->AddResidualBlock(cost, nullptr, blocks->translation(m.i),
-                              blocks->rotation(m.i), blocks->landmark(m.l));
+    problem->AddResidualBlock(cost, MakeLoss(loss, loss.landmark_threshold),
+                              blocks->translation(m.i), blocks->rotation(m.i),
+                              blocks->landmark(m.l));
   }
   for (const PosePrior& p : graph.priors) {
     if (p.has_rotation()) {
@@ -391,7 +399,8 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
         cost = new ceres::AutoDiffCostFunction<RotationPriorResidual<3>, 9, 4>(
             new RotationPriorResidual<3>(p));
       }
-      problem->AddResidualBlock(cost, nullptr, blocks->rotation(p.i));
+      problem->AddResidualBlock(cost, MakeLoss(loss, loss.prior_threshold),
+                                blocks->rotation(p.i));
     }
     if (p.has_position()) {
       ceres::CostFunction* cost;
@@ -402,7 +411,8 @@ bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
         cost = new ceres::AutoDiffCostFunction<PositionPriorResidual<3>, 3, 3>(
             new PositionPriorResidual<3>(p));
       }
-      problem->AddResidualBlock(cost, nullptr, blocks->translation(p.i));
+      problem->AddResidualBlock(cost, MakeLoss(loss, loss.prior_threshold),
+                                blocks->translation(p.i));
     }
   }
   const Gauge gauge = GaugeOf(graph);

@@ -43,8 +43,10 @@
 //   Huber:  rho(s) = s for s <= a^2, 2 a sqrt(s) - a^2 beyond;
 //   Cauchy: rho(s) = a^2 log(1 + s / a^2),
 // so threshold = c^2, the TLS threshold of robust_solver.h, compares the
-// losses with the robust solve on the same scale. Landmark measurements and
-// priors get no loss.
+// losses with the robust solve on the same scale. Landmark measurements get
+// the loss with their own landmark_threshold, and priors with
+// prior_threshold on each of their residual blocks (rotation and position
+// apart); with 0 (the default) they get none.
 
 #ifndef CERES_SESYNC_CERES_BASELINE_H_
 #define CERES_SESYNC_CERES_BASELINE_H_
@@ -67,6 +69,10 @@ struct CeresRobustLoss {
   Type type = Type::kNone;
   // a^2 on f_k (> 0 with a loss): where the loss leaves the quadratic.
   double threshold = 0;
+  // a^2 of the same loss on the f_k of landmark measurements, and on the
+  // rotation and position terms of priors (>= 0; 0: least squares there).
+  double landmark_threshold = 0;
+  double prior_threshold = 0;
 };
 
 struct CeresBaselineOptions {
@@ -163,9 +169,11 @@ struct CeresPoseBlocks {
 // graph.num_landmarks landmarks), sets the quaternion manifolds (3D) and
 // holds the gauge constant (see "Gauge" above). `problem` should be empty and
 // use the default ownership options. `loss` (default: none) puts a robust
-// loss on every pose-pose measurement. Returns false (problem untouched) if
-// the graph fails ValidatePoseGraph (landmarks and priors allowed), the sizes
-// disagree or a loss has no positive finite threshold.
+// loss on every pose-pose measurement (and on the landmark and prior terms
+// with their thresholds). Returns false (problem untouched) if the graph
+// fails ValidatePoseGraph (landmarks and priors allowed), the sizes disagree,
+// a loss has no positive finite threshold or a landmark or prior threshold
+// is negative or not finite.
 bool BuildCeresProblem(const PoseGraph& graph, CeresPoseBlocks* blocks,
                        ceres::Problem* problem, std::string* error,
                        const CeresRobustLoss& loss = {});

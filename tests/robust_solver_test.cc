@@ -1132,5 +1132,63 @@ TEST(CeresRobustLoss, LossesAreOnTheMeasurementTerms) {
   EXPECT_THAT(error, ::testing::HasSubstr("threshold"));
 }
 
+// With landmark and prior thresholds the loss reaches those terms too: the
+// robust objective Ceres reports is sum rho over the measurements, the
+// landmark measurements and each prior's rotation and position term, each
+// with its own a^2 (computed here from the result).
+TEST(CeresRobustLoss, LandmarkAndPriorTermsGetTheirOwnThresholds) {
+  LandmarkGraphOptions o = LandmarkCase(2, false, 4);
+  PoseGraph clean, graph;
+  std::string error;
+  ASSERT_TRUE(GenerateLandmarkGraph(o, &clean, nullptr, &error)) << error;
+  LandmarkOutlierOptions outliers;
+  outliers.landmark_fraction = 0.2;
+  outliers.prior_fraction = 0.2;
+  ASSERT_TRUE(
+      AddLandmarkOutliers(clean, outliers, &graph, nullptr, nullptr, &error))
+      << error;
+  const Poses poses = OdometryInitialization(graph);
+  const Solution initial{poses, InitialLandmarkPositions(graph, poses)};
+  const double a2 = 9, b2 = 5, p2 = 7;
+  auto cauchy = [](double s, double t) { return t * std::log1p(s / t); };
+  CeresBaselineOptions options;
+  options.method = CeresBaselineOptions::Method::kLevenbergMarquardt;
+  options.loss.type = CeresRobustLoss::Type::kCauchy;
+  options.loss.threshold = a2;
+  options.loss.landmark_threshold = b2;
+  options.loss.prior_threshold = p2;
+  Solution x;
+  CeresBaselineSummary summary;
+  ASSERT_TRUE(SolveWithCeres(graph, initial, options, &x, &summary, &error))
+      << error;
+  double robust = 0;
+  for (const RelativePoseMeasurement& e : graph.measurements) {
+    const Pose& p = x.poses[e.i];
+    const Pose& q = x.poses[e.j];
+    robust += cauchy(e.kappa * (q.R - p.R * e.R).squaredNorm() +
+                         e.tau * (q.t - p.t - p.R * e.t).squaredNorm(),
+                     a2);
+  }
+  for (const LandmarkMeasurement& m : graph.landmark_measurements) {
+    const Pose& p = x.poses[m.i];
+    robust +=
+        cauchy(m.nu * (x.landmarks[m.l] - p.t - p.R * m.z).squaredNorm(), b2);
+  }
+  for (const PosePrior& prior : graph.priors) {
+    const Pose& p = x.poses[prior.i];
+    if (prior.has_rotation()) {
+      robust += cauchy(prior.kappa * (p.R - prior.R).squaredNorm(), p2);
+    }
+    if (prior.has_position()) {
+      robust += cauchy(prior.tau * (p.t - prior.t).squaredNorm(), p2);
+    }
+  }
+  EXPECT_NEAR(summary.final_robust_objective, robust, 1e-8 * robust);
+  EXPECT_LT(summary.final_robust_objective, summary.final_objective);
+  options.loss.prior_threshold = -1;
+  EXPECT_FALSE(SolveWithCeres(graph, initial, options, &x, nullptr, &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("prior"));
+}
+
 }  // namespace
 }  // namespace ceres_sesync
