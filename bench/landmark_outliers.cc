@@ -103,23 +103,6 @@ struct Rates {
   }
 };
 
-// Each landmark at its optimal position in the clean graph for the poses
-// of x (the precision-weighted mean of the positions its observations
-// imply): F of the clean graph at the poses alone, so that a landmark
-// placed at a tie's wrong observation does not count against the poses.
-std::vector<Eigen::VectorXd> CleanLandmarks(const PoseGraph& clean,
-                                            const Poses& poses) {
-  std::vector<Eigen::VectorXd> sum(clean.num_landmarks,
-                                   Eigen::VectorXd::Zero(clean.dimension));
-  std::vector<double> weight(clean.num_landmarks, 0);
-  for (const LandmarkMeasurement& o : clean.landmark_measurements) {
-    sum[o.l] += o.nu * (poses[o.i].t + poses[o.i].R * o.z);
-    weight[o.l] += o.nu;
-  }
-  for (int l = 0; l < clean.num_landmarks; ++l) sum[l] /= weight[l];
-  return sum;
-}
-
 Rates Count(const std::vector<int>& added, const std::vector<int>& rejected) {
   const std::set<int> wrong(added.begin(), added.end());
   Rates r;
@@ -269,7 +252,7 @@ int Main() {
                   std::max(trans, (x.poses[i].t - optimum.poses[i].t).norm());
             }
             gap = (EvaluateObjective(clean, x.poses,
-                                     CleanLandmarks(clean, x.poses)) -
+                                     OptimalLandmarkPositions(clean, x.poses)) -
                    clean_summary.objective) /
                   clean_summary.objective;
           }
@@ -347,36 +330,19 @@ int Main() {
           const double time_s = SecondsSince(start);
           std::vector<int> edges, landmarks, priors;
           if (ok) {
-            for (size_t k = 0; k < corrupted.measurements.size(); ++k) {
-              const RelativePoseMeasurement& e = corrupted.measurements[k];
-              const Pose& a = x.poses[e.i];
-              const Pose& b = x.poses[e.j];
-              if (e.kappa * (b.R - a.R * e.R).squaredNorm() +
-                      e.tau * (b.t - a.t - a.R * e.t).squaredNorm() >
-                  options.loss.threshold) {
+            const std::vector<double> f = TermCosts(corrupted, x);
+            const std::vector<double> c2 = TermThresholds(defaults, corrupted);
+            const size_t m = corrupted.measurements.size();
+            const size_t first_prior =
+                m + corrupted.landmark_measurements.size();
+            for (size_t k = 0; k < f.size(); ++k) {
+              if (!(f[k] > c2[k])) continue;
+              if (k < m) {
                 edges.push_back(static_cast<int>(k));
-              }
-            }
-            for (size_t q = 0; q < corrupted.landmark_measurements.size();
-                 ++q) {
-              const LandmarkMeasurement& o = corrupted.landmark_measurements[q];
-              const Pose& a = x.poses[o.i];
-              if (o.nu * (x.landmarks[o.l] - a.t - a.R * o.z).squaredNorm() >
-                  options.loss.landmark_threshold) {
-                landmarks.push_back(static_cast<int>(q));
-              }
-            }
-            for (size_t q = 0; q < corrupted.priors.size(); ++q) {
-              const PosePrior& p = corrupted.priors[q];
-              const Pose& a = x.poses[p.i];
-              double f = 0;
-              if (p.has_rotation()) f += p.kappa * (a.R - p.R).squaredNorm();
-              if (p.has_position()) f += p.tau * (a.t - p.t).squaredNorm();
-              if (f > internal::ChiSquareQuantile(
-                          defaults.inlier_probability,
-                          (p.has_rotation() ? d * (d - 1) / 2 : 0) +
-                              (p.has_position() ? d : 0))) {
-                priors.push_back(static_cast<int>(q));
+              } else if (k < first_prior) {
+                landmarks.push_back(static_cast<int>(k - m));
+              } else {
+                priors.push_back(static_cast<int>(k - first_prior));
               }
             }
           }

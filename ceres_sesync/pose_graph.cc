@@ -8,6 +8,7 @@
 #include <unordered_set>
 
 #include "Eigen/LU"
+#include "ceres_sesync/internal/measurement_weights.h"
 
 namespace ceres_sesync {
 
@@ -281,23 +282,22 @@ double EvaluateObjective(const PoseGraph& graph, const Poses& poses,
       static_cast<int>(landmarks.size()) != graph.num_landmarks) {
     return std::numeric_limits<double>::quiet_NaN();
   }
-  double f = 0;
-  for (const auto& e : graph.measurements) {
-    const Pose& a = poses[e.i];
-    const Pose& b = poses[e.j];
-    f += e.kappa * (b.R - a.R * e.R).squaredNorm() +
-         e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
+  return internal::WeightedObjective(graph, {}, poses, landmarks);
+}
+
+LandmarkPositions OptimalLandmarkPositions(const PoseGraph& graph,
+                                           const Poses& poses) {
+  LandmarkPositions p(graph.num_landmarks,
+                      Eigen::VectorXd::Zero(graph.dimension));
+  std::vector<double> weight(graph.num_landmarks, 0);
+  for (const LandmarkMeasurement& o : graph.landmark_measurements) {
+    p[o.l] += o.nu * (poses[o.i].t + poses[o.i].R * o.z);
+    weight[o.l] += o.nu;
   }
-  for (const auto& o : graph.landmark_measurements) {
-    const Pose& a = poses[o.i];
-    f += o.nu * (landmarks[o.l] - a.t - a.R * o.z).squaredNorm();
+  for (int l = 0; l < graph.num_landmarks; ++l) {
+    if (weight[l] > 0) p[l] /= weight[l];
   }
-  for (const auto& p : graph.priors) {
-    const Pose& a = poses[p.i];
-    if (p.has_rotation()) f += p.kappa * (a.R - p.R).squaredNorm();
-    if (p.has_position()) f += p.tau * (a.t - p.t).squaredNorm();
-  }
-  return f;
+  return p;
 }
 
 Poses IdentityPoses(int dimension, int num_poses) {

@@ -195,6 +195,13 @@ inline double EvaluateObjective(const PoseGraph& graph,
   return EvaluateObjective(graph, solution.poses, solution.landmarks);
 }
 
+// The landmark positions that minimize F for fixed `poses` (one pose per
+// pose of `graph`): a landmark's position enters only its own measurements'
+// terms, so it is their nu-weighted mean of the positions t_i + R_i z they
+// imply. A landmark without measurements is left at the origin.
+LandmarkPositions OptimalLandmarkPositions(const PoseGraph& graph,
+                                           const Poses& poses);
+
 // Identity poses for the graph's dimension.
 Poses IdentityPoses(int dimension, int num_poses);
 

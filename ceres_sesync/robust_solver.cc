@@ -47,34 +47,6 @@ double TlsWeight(double r2, double mu, double c2) {
   return std::clamp(std::sqrt(c2 * mu * (mu + 1) / r2) - mu, 0.0, 1.0);
 }
 
-// f_k at `x` for every term (measurement_weights.h's order; unweighted:
-// the TLS residuals).
-std::vector<double> Costs(const PoseGraph& graph, const Solution& x) {
-  const Poses& poses = x.poses;
-  std::vector<double> f(internal::NumWeightedTerms(graph));
-  const size_t m = graph.measurements.size();
-  for (size_t k = 0; k < m; ++k) {
-    const RelativePoseMeasurement& e = graph.measurements[k];
-    const Pose& a = poses[e.i];
-    const Pose& b = poses[e.j];
-    f[k] = e.kappa * (b.R - a.R * e.R).squaredNorm() +
-           e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
-  }
-  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
-    const LandmarkMeasurement& o = graph.landmark_measurements[q];
-    const Pose& a = poses[o.i];
-    f[m + q] = o.nu * (x.landmarks[o.l] - a.t - a.R * o.z).squaredNorm();
-  }
-  for (size_t q = 0; q < graph.priors.size(); ++q) {
-    const PosePrior& p = graph.priors[q];
-    const Pose& a = poses[p.i];
-    double& cost = f[internal::PriorTerm(graph, q)];
-    if (p.has_rotation()) cost += p.kappa * (a.R - p.R).squaredNorm();
-    if (p.has_position()) cost += p.tau * (a.t - p.t).squaredNorm();
-  }
-  return f;
-}
-
 // Degrees of freedom of term k's f_k under the noise model: an edge
 // d(d+1)/2, a landmark measurement d, a prior d(d-1)/2 for its rotation
 // plus d for its position.
@@ -211,7 +183,7 @@ void FillEdges(const PoseGraph& graph, const Solution& x,
   const Poses& poses = x.poses;
   const size_t m = graph.measurements.size();
   const size_t prior_begin = internal::PriorTerm(graph, 0);
-  const std::vector<double> f = Costs(graph, x);
+  const std::vector<double> f = TermCosts(graph, x);
   s->edges.assign(f.size(), {});
   s->outlier_edges.clear();
   s->outlier_landmark_measurements.clear();
@@ -446,6 +418,51 @@ double InlierThreshold(const RobustSolverOptions& options, int dimension) {
                                      dimension * (dimension + 1) / 2);
 }
 
+std::vector<double> TermCosts(const PoseGraph& graph, const Solution& x) {
+  const Poses& poses = x.poses;
+  std::vector<double> f(internal::NumWeightedTerms(graph));
+  const size_t m = graph.measurements.size();
+  for (size_t k = 0; k < m; ++k) {
+    const RelativePoseMeasurement& e = graph.measurements[k];
+    const Pose& a = poses[e.i];
+    const Pose& b = poses[e.j];
+    f[k] = e.kappa * (b.R - a.R * e.R).squaredNorm() +
+           e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
+  }
+  for (size_t q = 0; q < graph.landmark_measurements.size(); ++q) {
+    const LandmarkMeasurement& o = graph.landmark_measurements[q];
+    const Pose& a = poses[o.i];
+    f[m + q] = o.nu * (x.landmarks[o.l] - a.t - a.R * o.z).squaredNorm();
+  }
+  for (size_t q = 0; q < graph.priors.size(); ++q) {
+    const PosePrior& p = graph.priors[q];
+    const Pose& a = poses[p.i];
+    double& cost = f[internal::PriorTerm(graph, q)];
+    if (p.has_rotation()) cost += p.kappa * (a.R - p.R).squaredNorm();
+    if (p.has_position()) cost += p.tau * (a.t - p.t).squaredNorm();
+  }
+  return f;
+}
+
+std::vector<double> TermThresholds(const RobustSolverOptions& options,
+                                   const PoseGraph& graph) {
+  const int d = graph.dimension;
+  if (!CheckOptions(options, d).empty()) return {};
+  // The quantile once per number of degrees of freedom (a bisection each).
+  std::vector<double> by_dofs(d * (d + 1) / 2 + 1, options.inlier_threshold);
+  if (options.inlier_threshold <= 0) {
+    for (size_t k = 1; k < by_dofs.size(); ++k) {
+      by_dofs[k] = internal::ChiSquareQuantile(options.inlier_probability,
+                                               static_cast<int>(k));
+    }
+  }
+  std::vector<double> c2(internal::NumWeightedTerms(graph));
+  for (size_t k = 0; k < c2.size(); ++k) {
+    c2[k] = by_dofs[TermDegreesOfFreedom(graph, k)];
+  }
+  return c2;
+}
+
 namespace {
 
 // One GNC schedule from the first solve's result, with its final inlier
@@ -513,14 +530,9 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   // Every term's threshold c_k^2 (a relative pose measurement's is c^2),
   // and the loops' length: the number of terms.
   const size_t K = internal::NumWeightedTerms(graph);
+  const std::vector<double> c2 = TermThresholds(options, graph);
   std::vector<int> dofs(K);
   for (size_t k = 0; k < K; ++k) dofs[k] = TermDegreesOfFreedom(graph, k);
-  std::vector<double> c2(K, s.inlier_threshold);
-  if (options.inlier_threshold <= 0) {
-    for (size_t k = m; k < K; ++k) {
-      c2[k] = internal::ChiSquareQuantile(options.inlier_probability, dofs[k]);
-    }
-  }
   // The unknowns' degrees of freedom: d(d+1)/2 per pose and d per landmark,
   // less the gauge's d(d+1)/2 without priors; and the terms' in `set`.
   const long unknown_dofs =
@@ -614,7 +626,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     const double g2 = fraction * c2[w];
     return g2 / (2 * f[w] - g2);
   };
-  std::vector<double> f0 = Costs(graph, x0);
+  std::vector<double> f0 = TermCosts(graph, x0);
   first_options.max_rank = options.solver_options.max_rank;
   if (within(f0, 1) &&
       first_problem.summary().status ==
@@ -625,7 +637,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // staircase continues where a rank cap stopped it (as Solve() would).
     first_problem.staircase().Run(&Y0);
     x0 = first_problem.staircase().Round(Y0);
-    f0 = Costs(graph, x0);
+    f0 = TermCosts(graph, x0);
   }
   first_problem.staircase().Report(Y0, x0);
   s.initial_summary = first_problem.summary();
@@ -661,8 +673,6 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     const auto run_start = Clock::now();
     GncRun run;
     run.record.gnc_threshold = fraction * s.inlier_threshold;
-    std::vector<double> g2(K);  // GNC's thresholds.
-    for (size_t k = 0; k < K; ++k) g2[k] = fraction * c2[k];
     if (start_set == nullptr && within(f0, fraction)) {
       // Every TLS weight is 1 at any mu: GNC would solve the first problem
       // again. Its result stands for this run (consistent at c^2 >= g^2).
@@ -682,89 +692,93 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     run.weights.assign(K, 1.0);  // Of the last solved problem.
     bool reported = true;        // The first solve was reported.
     std::string message;
-    double mu = start_set == nullptr ? initial_mu(f0, fraction) : 0;
-    auto surrogate = [&](double mu_k) {
-      double cost = 0;
-      for (size_t k = 0; k < K; ++k) {
-        cost += known[k] ? f[k] : TlsSurrogate(f[k], mu_k, g2[k]);
-      }
-      return cost;
-    };
     auto disconnected = [&](const std::string& what) {
       run.status = RobustSolverSummary::Status::kInlierGraphDisconnected;
       run.message = what + message;
       run.record.time_s = Seconds(run_start);
       return run;
     };
-    double previous_cost = surrogate(mu);
-    run.status = RobustSolverSummary::Status::kMaxIterations;
-    solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
-    solve_options.test_certificate_near_convergence = false;
-    if (options.gnc_relative_gradient_tolerance > 0) {
-      solve_options.relative_preconditioned_gradient_tolerance =
-          options.gnc_relative_gradient_tolerance;
-    }
-    if (options.gnc_relative_decrease_tolerance > 0) {
-      solve_options.relative_decrease_tolerance =
-          options.gnc_relative_decrease_tolerance;
-    }
-    solve_options.refine_rounded_solution = options.gnc_refine_rounded_solution;
-    solve_options.max_rank = std::min(
-        options.solver_options.max_rank,
-        options.gnc_max_rank > 0 ? std::max(options.gnc_max_rank, r0) : r0 + 2);
     if (start_set != nullptr) {  // No GNC: its accepted set is given.
       run.weights = *start_set;
       run.status = RobustSolverSummary::Status::kConverged;
-    }
-    for (int it = 0; start_set == nullptr && it < options.max_iterations;
-         ++it) {
-      if (!budget(solve_options)) {
-        run.status = RobustSolverSummary::Status::kTimeLimit;
-        break;
+    } else {
+      std::vector<double> g2(K);  // GNC's thresholds.
+      for (size_t k = 0; k < K; ++k) g2[k] = fraction * c2[k];
+      double mu = initial_mu(f0, fraction);
+      auto surrogate = [&](double mu_k) {
+        double cost = 0;
+        for (size_t k = 0; k < K; ++k) {
+          cost += known[k] ? f[k] : TlsSurrogate(f[k], mu_k, g2[k]);
+        }
+        return cost;
+      };
+      double previous_cost = surrogate(mu);
+      run.status = RobustSolverSummary::Status::kMaxIterations;
+      solve_options.proof_arithmetic = SolverOptions::ProofArithmetic::kDouble;
+      solve_options.test_certificate_near_convergence = false;
+      if (options.gnc_relative_gradient_tolerance > 0) {
+        solve_options.relative_preconditioned_gradient_tolerance =
+            options.gnc_relative_gradient_tolerance;
       }
-      const auto step_start = Clock::now();
-      MeasurementWeights next(K);
-      for (size_t k = 0; k < K; ++k) {
-        next[k] = known[k] ? 1.0 : TlsWeight(f[k], mu, g2[k]);
+      if (options.gnc_relative_decrease_tolerance > 0) {
+        solve_options.relative_decrease_tolerance =
+            options.gnc_relative_decrease_tolerance;
       }
-      KeepLandmarksObserved(graph, f, &next, 1.0);
-      if (!problem.SetWeights(next, &message)) {
-        run.accepted.assign(K, 0);
-        for (size_t k = 0; k < K; ++k) run.accepted[k] = next[k] > 0.5;
-        run.weights = next;
-        return disconnected("GNC step " + std::to_string(it + 1) + ": ");
+      solve_options.refine_rounded_solution =
+          options.gnc_refine_rounded_solution;
+      solve_options.max_rank =
+          std::min(options.solver_options.max_rank,
+                   options.gnc_max_rank > 0 ? std::max(options.gnc_max_rank, r0)
+                                            : r0 + 2);
+      for (int it = 0; it < options.max_iterations; ++it) {
+        if (!budget(solve_options)) {
+          run.status = RobustSolverSummary::Status::kTimeLimit;
+          break;
+        }
+        const auto step_start = Clock::now();
+        MeasurementWeights next(K);
+        for (size_t k = 0; k < K; ++k) {
+          next[k] = known[k] ? 1.0 : TlsWeight(f[k], mu, g2[k]);
+        }
+        KeepLandmarksObserved(graph, f, &next, 1.0);
+        if (!problem.SetWeights(next, &message)) {
+          run.accepted.assign(K, 0);
+          for (size_t k = 0; k < K; ++k) run.accepted[k] = next[k] > 0.5;
+          run.weights = next;
+          return disconnected("GNC step " + std::to_string(it + 1) + ": ");
+        }
+        run.weights = std::move(next);
+        Y = ReduceRank(Y, d, r0, kRankTolerance);
+        problem.staircase().Run(&Y, /*verify_at_max_rank=*/false);
+        run.x = problem.staircase().Round(Y);
+        reported = false;
+        f = TermCosts(graph, run.x);
+        const double cost = surrogate(mu);
+        const SolverSummary& solve = problem.summary();
+        RobustSolverSummary::Iteration record;
+        record.mu = mu;
+        record.surrogate_cost = cost;
+        for (double w : run.weights) {
+          record.num_zero_weights += w == 0;
+          record.num_unit_weights += w == 1;
+        }
+        record.status = solve.status;
+        record.rank = solve.final_rank;
+        record.solver_iterations = solve.iterations;
+        record.optimization_time_s = solve.optimization_time_s;
+        record.verification_time_s = solve.verification_time_s;
+        record.time_s = Seconds(step_start);
+        run.history.push_back(record);
+        run.record.iterations = it + 1;
+        mu *= options.mu_step;
+        if (Binary(run.weights, options.weight_tolerance) ||
+            std::abs(cost - previous_cost) <=
+                options.relative_cost_tolerance * previous_cost) {
+          run.status = RobustSolverSummary::Status::kConverged;
+          break;
+        }
+        previous_cost = cost;
       }
-      run.weights = std::move(next);
-      Y = ReduceRank(Y, d, r0, kRankTolerance);
-      problem.staircase().Run(&Y, /*verify_at_max_rank=*/false);
-      run.x = problem.staircase().Round(Y);
-      reported = false;
-      f = Costs(graph, run.x);
-      const double cost = surrogate(mu);
-      const SolverSummary& solve = problem.summary();
-      RobustSolverSummary::Iteration record;
-      record.mu = mu;
-      record.surrogate_cost = cost;
-      for (double w : run.weights) {
-        record.num_zero_weights += w == 0;
-        record.num_unit_weights += w == 1;
-      }
-      record.status = solve.status;
-      record.rank = solve.final_rank;
-      record.solver_iterations = solve.iterations;
-      record.optimization_time_s = solve.optimization_time_s;
-      record.verification_time_s = solve.verification_time_s;
-      record.time_s = Seconds(step_start);
-      run.history.push_back(record);
-      run.record.iterations = it + 1;
-      mu *= options.mu_step;
-      if (Binary(run.weights, options.weight_tolerance) ||
-          std::abs(cost - previous_cost) <=
-              options.relative_cost_tolerance * previous_cost) {
-        run.status = RobustSolverSummary::Status::kConverged;
-        break;
-      }
-      previous_cost = cost;
     }
     run.weights_binary = Binary(run.weights, options.weight_tolerance);
     const auto inlier_start = Clock::now();
@@ -777,7 +791,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     for (size_t k = 0; k < K; ++k) run.accepted[k] = run.weights[k] > 0.5;
     KeepLandmarksObserved(graph, f, &run.accepted, char{1});
     auto record = [&]() {
-      f = Costs(graph, run.x);
+      f = TermCosts(graph, run.x);
       run.record.tls_cost = TlsCost(f, known, c2);
       for (char a : run.accepted) run.record.num_outliers += !a;
       run.record.certified = run.inlier_summary.certified();
@@ -801,7 +815,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       cut.dimension = d;
       cut.num_poses = graph.num_poses;
       cut.num_landmarks = graph.num_landmarks;
-      const std::vector<double> costs = Costs(graph, run.x);
+      const std::vector<double> costs = TermCosts(graph, run.x);
       for (size_t k = 0; k < K; ++k) {
         if (!run.accepted[k]) continue;
         ++(k < m                               ? cut.num_measurements
@@ -843,7 +857,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // lowers the accepted sum), so the rounds end.
     auto make_consistent = [&]() {
       for (int round = 0; round < options.max_consistency_rounds; ++round) {
-        f = Costs(graph, run.x);
+        f = TermCosts(graph, run.x);
         std::vector<char> next(K);
         for (size_t k = 0; k < K; ++k) {
           next[k] = known[k] ? run.accepted[k] : f[k] <= c2[k];
@@ -895,7 +909,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       return sum;
     };
     for (int trial = 0; trial < options.max_readmission_trials; ++trial) {
-      f = Costs(graph, run.x);
+      f = TermCosts(graph, run.x);
       // The accepted set's a-posteriori variance factor at its optimum:
       // its cost over its redundancy (the accepted terms' degrees of
       // freedom beyond the unknowns': d(d+1)/2 per measurement beyond a
@@ -932,7 +946,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       if (!solve_set(set, &Y_trial, &x_trial)) {
         return disconnected("re-admission trial: ");
       }
-      const std::vector<double> f_trial = Costs(graph, x_trial);
+      const std::vector<double> f_trial = TermCosts(graph, x_trial);
       const double rise = accepted_sum(f_trial, set) - accepted_cost;
       // (A trial cut short by the time limit is not kept.)
       if (problem.summary().status != SolverSummary::Status::kTimeLimit &&
@@ -1012,18 +1026,12 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       accepted[internal::PriorTerm(graph, q)] =
           nested_summary.edges[m + q].inlier;
     }
-    // Each landmark at the precision-weighted mean of the positions its
-    // observations imply, then moved by the consensus.
+    // Each landmark at its least-squares position, then moved by the
+    // consensus.
     Solution x{std::move(nested_x.poses), {}};
-    x.landmarks.assign(graph.num_landmarks, Eigen::VectorXd::Zero(d));
-    std::vector<double> weight(graph.num_landmarks, 0);
-    for (const LandmarkMeasurement& o : graph.landmark_measurements) {
-      x.landmarks[o.l] += o.nu * (x.poses[o.i].t + x.poses[o.i].R * o.z);
-      weight[o.l] += o.nu;
-    }
-    for (int l = 0; l < graph.num_landmarks; ++l) x.landmarks[l] /= weight[l];
+    x.landmarks = OptimalLandmarkPositions(graph, x.poses);
     LandmarkConsensus(graph, x, c2, &accepted);
-    KeepLandmarksObserved(graph, Costs(graph, x), &accepted, char{1});
+    KeepLandmarksObserved(graph, TermCosts(graph, x), &accepted, char{1});
     set->assign(accepted.begin(), accepted.end());
     return true;
   };
@@ -1162,6 +1170,18 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.inlier_summary = best.inlier_summary;
   FillEdges(graph, best.x, best.weights, known, best.accepted, c2, &s);
   return finish(best.status, std::move(best.x));
+}
+
+const char* RobustSolverSummary::Edge::KindString() const {
+  switch (kind) {
+    case Kind::kLandmark:
+      return "landmark";
+    case Kind::kPrior:
+      return "prior";
+    case Kind::kMeasurement:
+      break;
+  }
+  return "measurement";
 }
 
 bool RobustSolverSummary::certified() const {
@@ -1303,17 +1323,14 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
   }
   out += "\nPer-edge verdicts";
   out += all_edges ? " (all)\n" : " (rejected)\n";
-  line("  %8s %8s %10s %10s %9s %12s %12s %12s %9s %s\n", "kind", "index",
+  line("  %11s %8s %10s %10s %9s %12s %12s %12s %9s %s\n", "kind", "index",
        "vertex i", "vertex j", "weight", "rot. [deg]", "trans.", "f_k", "c_k^2",
        "verdict");
   for (size_t k = 0; k < edges.size(); ++k) {
     const Edge& e = edges[k];
     if (!all_edges && e.inlier) continue;
-    line("  %8s %8d %10lld %10lld %9.3g %12.4g %12.4g %12.4g %9.4g %s\n",
-         e.kind == Edge::Kind::kMeasurement ? "edge"
-         : e.kind == Edge::Kind::kLandmark  ? "landmark"
-                                            : "prior",
-         e.index, static_cast<long long>(e.vertex_i),
+    line("  %11s %8d %10lld %10lld %9.3g %12.4g %12.4g %12.4g %9.4g %s\n",
+         e.KindString(), e.index, static_cast<long long>(e.vertex_i),
          static_cast<long long>(e.vertex_j), e.weight, e.rotation_residual_deg,
          e.translation_residual, e.cost, e.threshold,
          e.inlier ? (e.known_inlier ? "inlier (known)" : "inlier") : "outlier");

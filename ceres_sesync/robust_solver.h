@@ -349,6 +349,8 @@ struct RobustSolverSummary {
     // graph.landmark_measurements or graph.priors.
     enum class Kind { kMeasurement, kLandmark, kPrior };
     Kind kind = Kind::kMeasurement;
+    // "measurement", "landmark" or "prior" (reports, JSON, CSV, Python).
+    const char* KindString() const;
     int index = 0;
     // The original vertex ids (PoseGraph::vertex_ids) of the measured poses;
     // for a landmark measurement the observing pose's and the landmark's
@@ -480,6 +482,17 @@ bool IsOdometry(const RelativePoseMeasurement& measurement);
 // The TLS threshold c^2 the options give for dimension d (see
 // RobustSolverOptions::inlier_threshold); NaN for invalid options.
 double InlierThreshold(const RobustSolverOptions& options, int dimension);
+
+// f_k of every term at `solution` (pose_graph.h's terms, unweighted: the
+// TLS residuals), in the order of RobustSolverSummary::edges: the
+// measurements, then the landmark measurements, then the priors (a prior's
+// rotation and position parts together).
+std::vector<double> TermCosts(const PoseGraph& graph, const Solution& solution);
+
+// The TLS threshold c_k^2 of every term, in the same order (see
+// inlier_threshold); empty for invalid options.
+std::vector<double> TermThresholds(const RobustSolverOptions& options,
+                                   const PoseGraph& graph);
 
 // Solves the pose graph robustly (see the top of this file). Returns the
 // poses of the final inlier problem (in Solve()'s gauge), or those of the

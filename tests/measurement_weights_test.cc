@@ -182,10 +182,9 @@ TEST(MeasurementWeights, ObjectiveAndBoundAreThoseOfTheScaledGraph) {
     const WeightedCase c = MakeCase(d, 11, false);
     const PoseGraph scaled = Scaled(c.graph, c.weights);
     const Poses poses = test_util::RandomPoses(d, c.graph.num_poses, 2.0, &rng);
-    EXPECT_EQ(
-        internal::WeightedObjective(c.graph, c.weights, Solution{poses, {}}),
-        EvaluateObjective(scaled, poses));
-    EXPECT_EQ(internal::WeightedObjective(c.graph, {}, Solution{poses, {}}),
+    EXPECT_EQ(internal::WeightedObjective(c.graph, c.weights, poses),
+              EvaluateObjective(scaled, poses));
+    EXPECT_EQ(internal::WeightedObjective(c.graph, {}, poses),
               EvaluateObjective(c.graph, poses));
     EXPECT_EQ(internal::ObjectiveUpperBound(c.graph, poses, {}, c.weights),
               internal::ObjectiveUpperBound(scaled, poses));
@@ -313,7 +312,7 @@ TEST(MeasurementWeights, ReweightedStaircaseEqualsFreshStaircase) {
     EXPECT_EQ(first.objective, second.objective);
     EXPECT_EQ(first.lower_bound, second.lower_bound);
     EXPECT_EQ(second.objective,
-              internal::WeightedObjective(a.graph, w2, Solution{p_fresh, {}}));
+              internal::WeightedObjective(a.graph, w2, p_fresh));
     EXPECT_TRUE(first.certified()) << first.FullReport();
     ASSERT_EQ(p_reused.size(), p_fresh.size());
     for (size_t i = 0; i < p_fresh.size(); ++i) {
@@ -466,8 +465,9 @@ TEST(MeasurementWeights, LandmarkAndPriorTermsAreWeighted) {
       x.landmarks.push_back(Eigen::VectorXd::NullaryExpr(
           d, [&](Eigen::Index) { return 3 * normal(rng); }));
     }
-    EXPECT_EQ(internal::WeightedObjective(c.graph, c.weights, x),
-              EvaluateObjective(scaled, x));
+    EXPECT_EQ(
+        internal::WeightedObjective(c.graph, c.weights, x.poses, x.landmarks),
+        EvaluateObjective(scaled, x));
     EXPECT_EQ(
         internal::ObjectiveUpperBound(c.graph, x.poses, x.landmarks, c.weights),
         internal::ObjectiveUpperBound(scaled, x.poses, x.landmarks));
@@ -546,8 +546,9 @@ TEST(MeasurementWeights, CutOffLandmarkOrWorldIsRejected) {
   }
   EXPECT_FALSE(internal::CheckMeasurementWeights(g, w, &error));
   EXPECT_THAT(error, ::testing::HasSubstr("world frame"));
-  // Only the start prior (no position prior left with a position term
-  // among the GPS ones would still connect t_w through it): fine.
+  // The start prior alone (a full pose prior: its position term keeps the
+  // world's translation node connected once every GPS prior is rejected):
+  // connected.
   for (size_t q = 0; q < g.priors.size(); ++q) {
     w[internal::PriorTerm(g, q)] = g.priors[q].has_rotation() ? 1 : 0;
   }

@@ -937,6 +937,15 @@ TEST(RobustSolver, WrongLandmarkAssociationsAndFalseFixesAreRejected) {
     EXPECT_DOUBLE_EQ(bad.threshold,
                      internal::ChiSquareQuantile(
                          RobustSolverOptions().inlier_probability, d));
+    // The public per-term costs and thresholds are the verdicts' own.
+    const std::vector<double> costs = TermCosts(corrupted, x);
+    const std::vector<double> thresholds = TermThresholds(Options(), corrupted);
+    ASSERT_EQ(costs.size(), s.edges.size());
+    ASSERT_EQ(thresholds.size(), s.edges.size());
+    for (size_t k = 0; k < s.edges.size(); ++k) {
+      EXPECT_EQ(costs[k], s.edges[k].cost) << k;
+      EXPECT_EQ(thresholds[k], s.edges[k].threshold) << k;
+    }
     const RobustSolverSummary::Edge& fix =
         s.edges[s.edges.size() - corrupted.priors.size() + added_p[0]];
     EXPECT_EQ(fix.kind, RobustSolverSummary::Edge::Kind::kPrior);

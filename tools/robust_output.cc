@@ -5,20 +5,6 @@
 #include "ceres_sesync/internal/file_util.h"
 
 namespace ceres_sesync::tools {
-namespace {
-
-const char* KindName(RobustSolverSummary::Edge::Kind kind) {
-  switch (kind) {
-    case RobustSolverSummary::Edge::Kind::kLandmark:
-      return "landmark";
-    case RobustSolverSummary::Edge::Kind::kPrior:
-      return "prior";
-    default:
-      return "measurement";
-  }
-}
-
-}  // namespace
 
 bool ParseKnownInliers(const std::string& name,
                        RobustSolverOptions::KnownInliers* known_inliers) {
@@ -57,7 +43,7 @@ void AddRobustJson(const RobustSolverSummary& summary,
   json->BeginArray("edges");
   for (const RobustSolverSummary::Edge& e : summary.edges) {
     json->BeginObject();
-    json->String("kind", KindName(e.kind));
+    json->String("kind", e.KindString());
     json->Int("index", e.index);
     json->Number("weight", e.weight);
     json->Bool("inlier", e.inlier);
@@ -85,7 +71,7 @@ bool WriteEdgeReport(const std::string& path,
                   static_cast<long long>(e.vertex_j), e.weight,
                   e.inlier ? 1 : 0, e.known_inlier ? 1 : 0,
                   e.rotation_residual_deg, e.translation_residual, e.cost,
-                  KindName(e.kind), e.index, e.threshold);
+                  e.KindString(), e.index, e.threshold);
     csv += line;
   }
   return internal::WriteFileAtomically(path, csv, error);

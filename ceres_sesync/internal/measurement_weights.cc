@@ -110,9 +110,8 @@ bool CheckMeasurementWeights(const PoseGraph& graph,
 }
 
 double WeightedObjective(const PoseGraph& graph,
-                         const MeasurementWeights& weights,
-                         const Solution& solution) {
-  const Poses& poses = solution.poses;
+                         const MeasurementWeights& weights, const Poses& poses,
+                         const LandmarkPositions& landmarks) {
   double f = 0;
   for (size_t k = 0; k < graph.measurements.size(); ++k) {
     const RelativePoseMeasurement& e = graph.measurements[k];
@@ -126,7 +125,7 @@ double WeightedObjective(const PoseGraph& graph,
     const LandmarkMeasurement& o = graph.landmark_measurements[q];
     const Pose& a = poses[o.i];
     f += WeightedPrecision(o, weights, LandmarkTerm(graph, q)) *
-         (solution.landmarks[o.l] - a.t - a.R * o.z).squaredNorm();
+         (landmarks[o.l] - a.t - a.R * o.z).squaredNorm();
   }
   for (size_t q = 0; q < graph.priors.size(); ++q) {
     const PosePrior& p = graph.priors[q];

@@ -6,8 +6,8 @@
 // then the landmark measurements (k = m + q), then the priors (k = m + M + q),
 // NumWeightedTerms(graph) in all. Its precisions are the doubles
 //
-//   kappa_k^w = fl(w_k kappa_k),  tau_k^w = fl(w_k tau_k),  nu_k^w = fl(w_k
-//   nu_k),
+//   kappa_k^w = fl(w_k kappa_k),  tau_k^w = fl(w_k tau_k),
+//   nu_k^w = fl(w_k nu_k),
 //
 // rounded once, and the weighted problem is DEFINED by them: every consumer
 // (the data matrices of sesync_problem.h and their rounding bounds, the
@@ -85,11 +85,12 @@ bool CheckMeasurementWeights(const PoseGraph& graph,
                              const MeasurementWeights& weights,
                              std::string* error);
 
-// F of the weighted problem at `solution`: pose_graph.h's F with the
-// weighted precisions (EvaluateObjective for empty weights, bitwise).
+// F of the weighted problem at `poses` and `landmarks` (sizes as for
+// EvaluateObjective, unchecked): pose_graph.h's F with the weighted
+// precisions. EvaluateObjective is this with empty weights.
 double WeightedObjective(const PoseGraph& graph,
-                         const MeasurementWeights& weights,
-                         const Solution& solution);
+                         const MeasurementWeights& weights, const Poses& poses,
+                         const LandmarkPositions& landmarks = {});
 
 }  // namespace ceres_sesync::internal
 

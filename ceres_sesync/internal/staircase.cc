@@ -1097,9 +1097,8 @@ Solution Staircase::Round(const Eigen::MatrixXd& Y) {
 }
 
 double Staircase::Objective(const Solution& solution) const {
-  return problem_->weights().empty()
-             ? EvaluateObjective(graph_, solution)
-             : WeightedObjective(graph_, problem_->weights(), solution);
+  return WeightedObjective(graph_, problem_->weights(), solution.poses,
+                           solution.landmarks);
 }
 
 bool Staircase::Continue(Eigen::MatrixXd* Y, Solution* solution) {

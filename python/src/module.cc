@@ -1022,12 +1022,7 @@ void BindRobust(py::module_& m) {
                     "status is the string of StatusString().");
   py::class_<S::Edge> edge(cls, "Edge", "RobustSolverSummary::Edge");
   Fields(edge)
-      .get("kind",
-           [](const S::Edge& e) {
-             return e.kind == S::Edge::Kind::kMeasurement ? "measurement"
-                    : e.kind == S::Edge::Kind::kLandmark  ? "landmark"
-                                                          : "prior";
-           })
+      .get("kind", [](const S::Edge& e) { return e.KindString(); })
       .ro("index", &S::Edge::index)
       .ro("vertex_i", &S::Edge::vertex_i)
       .ro("vertex_j", &S::Edge::vertex_j)
