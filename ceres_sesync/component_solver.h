@@ -8,14 +8,19 @@
 //       ceres_sesync::SolveByComponent(graph, options, &summary);
 //   std::cout << summary.FullReport();
 //
-// Measurements never link two components, so the objective (12) is the sum
-// of the components' objectives and each component has its own gauge: the
-// relative placement of two components is not observable. Each component is
-// solved by Solve() as a pose graph of its own, in its own gauge: its FIX
-// pose if it holds the graph's, else its first pose (smallest index), at that
-// pose's initial value if the graph has VERTEX poses, else at the identity.
-// The optimum of the whole graph is the sum of the components' optima, so the
-// sum of their proven lower bounds is a proven lower bound of the whole.
+// A component is a maximal set of poses and landmarks linked by relative pose
+// measurements and landmark measurements; priors link their poses to the
+// world frame, so all poses with priors are in one component. No term links
+// two components, so the objective (pose_graph.h's F) is the sum of the
+// components' objectives and each component without priors has its own
+// gauge: the relative placement of two components is not observable. Each
+// component is solved by Solve() as a graph of its own (with its landmarks
+// and priors), in its own gauge: the world frame if it has the priors, else
+// its FIX pose if it holds the graph's, else its first pose (smallest index),
+// at that pose's initial value if the graph has VERTEX poses, else at the
+// identity (its landmarks move with its poses). The optimum of the whole graph
+// is the sum of the components' optima, so the sum of their proven lower
+// bounds is a proven lower bound of the whole.
 
 #ifndef CERES_SESYNC_COMPONENT_SOLVER_H_
 #define CERES_SESYNC_COMPONENT_SOLVER_H_
@@ -37,9 +42,14 @@ struct PoseGraphComponent {
   // Indices of the component's measurements in the whole graph, ascending:
   // measurements[k] is measurement k of `graph`.
   std::vector<int> measurements;
-  // The component as a pose graph of its own (local indices 0..size-1; vertex
-  // ids, initial poses and the FIX pose, if it is in this component, carried
-  // over).
+  // The same for its landmarks (landmarks[k] is landmark k of `graph`), its
+  // landmark measurements and its priors.
+  std::vector<int> landmarks;
+  std::vector<int> landmark_measurements;
+  std::vector<int> priors;
+  // The component as a graph of its own (local indices; vertex and landmark
+  // ids, initial poses and landmark positions, and the FIX pose, if it is in
+  // this component, carried over).
   PoseGraph graph;
 };
 
@@ -50,9 +60,11 @@ std::vector<PoseGraphComponent> SplitIntoComponents(const PoseGraph& graph);
 
 struct ComponentsSummary {
   struct Component {
-    std::vector<int> poses;  // As PoseGraphComponent::poses.
-    int num_measurements = 0;
-    // Vertex id of the component's gauge pose (see above).
+    std::vector<int> poses;      // As PoseGraphComponent::poses.
+    std::vector<int> landmarks;  // As PoseGraphComponent::landmarks.
+    int num_measurements = 0, num_landmark_measurements = 0, num_priors = 0;
+    // Vertex id of the component's gauge pose (see above); -1 for the
+    // component with the priors (they place it in the world frame).
     int64_t gauge_vertex_id = 0;
     SolverSummary summary;  // Solve() on the component.
   };
@@ -63,6 +75,7 @@ struct ComponentsSummary {
   SolverSummary::Status status = SolverSummary::Status::kInvalidInput;
   std::string message;
   int dimension = 0, num_poses = 0, num_measurements = 0;
+  int num_landmarks = 0, num_landmark_measurements = 0, num_priors = 0;
   std::vector<Component> components;
   // Sums over the components: F(x) of the returned poses, the proven lower
   // bound on the optimum, their difference, and that relative to the lower
@@ -86,10 +99,13 @@ struct ComponentsSummary {
 
 // Validates `graph` (all of ValidatePoseGraph but connectivity), splits it
 // into its connected components and solves each with Solve() and `options`
-// (one at a time; a max_time_s limit counts for the whole call). Returns one
-// pose per pose of `graph` (empty on invalid input). options.progress, if
-// set, receives each component's reports with SolverProgress::component and
-// num_components filled in.
+// (one at a time; a max_time_s limit counts for the whole call). *solution
+// gets one pose per pose of `graph` and one position per landmark (both empty
+// on invalid input). options.progress, if set, receives each component's
+// reports with SolverProgress::component and num_components filled in.
+void SolveByComponent(const PoseGraph& graph, const SolverOptions& options,
+                      Solution* solution, ComponentsSummary* summary);
+// The same, returning the poses only.
 Poses SolveByComponent(const PoseGraph& graph, const SolverOptions& options,
                        ComponentsSummary* summary);
 

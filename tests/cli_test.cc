@@ -258,13 +258,41 @@ TEST_F(CliTest, LandmarksAndPriorsThroughSolveAndCertify) {
   EXPECT_THAT(run.err, HasSubstr("55"));
   EXPECT_FALSE(fs::exists(certify_json));
 
-  // --components does not split landmarks and priors: refused, no output.
+  // --components with a triangle and an edge beside the map: the map is one
+  // component with its landmarks and prior, solved in the world frame (the
+  // same exact map), the others each in its own gauge.
   fs::remove(solved);
-  run = RunToolWithOutput("solve " + graph_path + " --components --output " +
-                          solved);
-  EXPECT_EQ(run.exit_code, 2) << run.output;
-  EXPECT_THAT(run.err, HasSubstr("landmarks and priors"));
-  EXPECT_FALSE(fs::exists(solved));
+  const std::string three_path = TempPath("landmarks_three.g2o");
+  WriteText(three_path, std::string(kLandmarks2d) +
+                            "EDGE_SE2 200 201 1 0 0 1 0 0 1 0 1\n"
+                            "EDGE_SE2 201 202 1 0 0.1 1 0 0 1 0 1\n"
+                            "EDGE_SE2 202 200 -2 0.1 0 1 0 0 1 0 1\n"
+                            "EDGE_SE2 300 301 1 0 0.5 1 0 0 1 0 1\n");
+  run = RunToolWithOutput("solve " + three_path + " --components --output " +
+                          solved + " --json " + json_path);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.out, HasSubstr("Landmark measurements              6"));
+  EXPECT_THAT(run.out, HasSubstr("world"));
+  const std::string cjson3 = ReadText(json_path);
+  ASSERT_TRUE(IsValidJson(cjson3)) << cjson3;
+  EXPECT_THAT(cjson3, HasSubstr("\"num_components\": 3"));
+  EXPECT_THAT(cjson3, HasSubstr("\"landmark_ids\": [100, 7, 55]"));
+  EXPECT_THAT(cjson3, HasSubstr("\"gauge_vertex_id\": -1"));
+  PoseGraph three;
+  G2oReadOptions disconnected;
+  disconnected.allow_disconnected = true;
+  ASSERT_TRUE(ReadG2oFile(three_path, disconnected, &three, &error)) << error;
+  Solution y;
+  ASSERT_TRUE(ReadG2oSolution(solved, three, &y, &error)) << error;
+  EXPECT_LT(
+      (y.landmarks[three.FindLandmark(100)] - Eigen::Vector2d(2, 0.5)).norm(),
+      1e-9);
+  EXPECT_LT((y.poses[three.FindVertex(30)].t - Eigen::Vector2d(1, 1)).norm(),
+            1e-9);
+  EXPECT_NEAR(JsonNumber(cjson3, "\"graph\"", "objective"),
+              EvaluateObjective(three, y), 1e-12);
+  fs::remove(three_path);
+  fs::remove(solved);
 
   // A bad landmark line: the file and line, exit 2, nothing written.
   WriteText(graph_path,

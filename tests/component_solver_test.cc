@@ -129,6 +129,181 @@ TEST(ComponentSolver, EachComponentIsSolvedExactlyAsItsOwnGraph) {
   }
 }
 
+// A landmark graph (test_util::RandomLandmarkGraph) with priors or without.
+PoseGraph RandomWithLandmarks(int d, int n, uint64_t seed, bool priors) {
+  test_util::RandomLandmarkGraphOptions o;
+  o.poses.dimension = d;
+  o.poses.num_poses = n;
+  o.poses.num_loop_closures = n / 3;
+  o.poses.kappa = 50;
+  o.poses.tau = 20;
+  o.poses.seed = seed;
+  o.num_landmarks = 6;
+  o.observations_per_landmark = 3;
+  if (priors) {
+    o.num_position_priors = 2;
+    o.num_pose_priors = 1;
+  }
+  return test_util::RandomLandmarkGraph(o, nullptr);
+}
+
+// Merge() with the landmarks (part p's landmark k gets id 1000 p + 500 + k),
+// landmark measurements and priors interleaved too; lm_index[part][local
+// landmark] is where each landmark went.
+Merged MergeWithLandmarks(const std::vector<PoseGraph>& parts,
+                          std::vector<std::vector<int>>* lm_index) {
+  Merged merged = Merge(parts);
+  lm_index->assign(parts.size(), {});
+  PoseGraph& g = merged.graph;
+  for (int k = 0;; ++k) {
+    bool any = false;
+    for (size_t p = 0; p < parts.size(); ++p) {
+      if (k >= parts[p].num_landmarks) continue;
+      any = true;
+      (*lm_index)[p].push_back(g.AddLandmark(1000 * p + 500 + k));
+    }
+    if (!any) break;
+  }
+  for (size_t q = 0;; ++q) {
+    bool any = false;
+    for (size_t p = 0; p < parts.size(); ++p) {
+      if (q < parts[p].landmark_measurements.size()) {
+        any = true;
+        LandmarkMeasurement o = parts[p].landmark_measurements[q];
+        o.i = merged.index[p][o.i];
+        o.l = (*lm_index)[p][o.l];
+        g.landmark_measurements.push_back(std::move(o));
+      }
+      if (q < parts[p].priors.size()) {
+        any = true;
+        PosePrior prior = parts[p].priors[q];
+        prior.i = merged.index[p][prior.i];
+        g.priors.push_back(std::move(prior));
+      }
+    }
+    if (!any) break;
+  }
+  return merged;
+}
+
+TEST(ComponentSolver, LandmarksAndPriorsAreSolvedWithTheirComponent) {
+  for (int d : {2, 3}) {
+    SCOPED_TRACE(d);
+    // A landmark map in the world frame, a landmark map in a gauge of its
+    // own, and a plain pose graph.
+    const std::vector<PoseGraph> parts = {
+        RandomWithLandmarks(d, 12, 21, /*priors=*/true),
+        RandomWithLandmarks(d, 9, 22, /*priors=*/false), Random(d, 7, 23)};
+    ASSERT_FALSE(parts[0].priors.empty());
+    ASSERT_GT(parts[1].num_landmarks, 0);
+    std::vector<std::vector<int>> lm_index;
+    const Merged merged = MergeWithLandmarks(parts, &lm_index);
+    const PoseGraph& g = merged.graph;
+    ASSERT_EQ(ConnectedComponents(g, nullptr), 3);
+
+    const std::vector<PoseGraphComponent> split = SplitIntoComponents(g);
+    ASSERT_EQ(split.size(), 3u);
+    const SolverOptions options;
+    ComponentsSummary summary;
+    Solution x;
+    SolveByComponent(g, options, &x, &summary);
+    ASSERT_TRUE(summary.certified()) << summary.FullReport();
+    ASSERT_EQ(static_cast<int>(x.poses.size()), g.num_poses);
+    ASSERT_EQ(static_cast<int>(x.landmarks.size()), g.num_landmarks);
+    EXPECT_EQ(summary.num_landmarks, g.num_landmarks);
+    EXPECT_EQ(summary.num_priors, static_cast<int>(g.priors.size()));
+    double objective = 0;
+    for (size_t p = 0; p < parts.size(); ++p) {
+      SCOPED_TRACE(p);
+      const PoseGraph& part = parts[p];
+      // The split gives back the part: its terms in order, re-indexed.
+      const PoseGraph& back = split[p].graph;
+      ASSERT_EQ(back.num_landmarks, part.num_landmarks);
+      ASSERT_EQ(back.landmark_measurements.size(),
+                part.landmark_measurements.size());
+      ASSERT_EQ(back.priors.size(), part.priors.size());
+      EXPECT_EQ(split[p].landmarks, lm_index[p]);
+      for (int k = 0; k < part.num_landmarks; ++k) {
+        EXPECT_EQ(back.landmark_ids[k], g.landmark_ids[lm_index[p][k]]);
+      }
+      for (size_t q = 0; q < part.landmark_measurements.size(); ++q) {
+        const LandmarkMeasurement& a = part.landmark_measurements[q];
+        const LandmarkMeasurement& b = back.landmark_measurements[q];
+        EXPECT_EQ(b.i, a.i);
+        EXPECT_EQ(b.l, a.l);
+        EXPECT_EQ(b.z, a.z);
+        EXPECT_EQ(g.landmark_measurements[split[p].landmark_measurements[q]].z,
+                  a.z);
+      }
+      for (size_t q = 0; q < part.priors.size(); ++q) {
+        EXPECT_EQ(back.priors[q].i, part.priors[q].i);
+        EXPECT_EQ(back.priors[q].t, part.priors[q].t);
+        EXPECT_EQ(g.priors[split[p].priors[q]].t, part.priors[q].t);
+      }
+
+      // Same data in the same order: bitwise the same solve as the part
+      // alone, poses and landmarks.
+      SolverSummary alone;
+      Solution y;
+      Solve(part, options, &y, &alone);
+      ASSERT_TRUE(alone.certified()) << alone.FullReport();
+      const ComponentsSummary::Component& c = summary.components[p];
+      EXPECT_EQ(c.poses, merged.index[p]);
+      EXPECT_EQ(c.landmarks, lm_index[p]);
+      EXPECT_EQ(c.num_landmark_measurements,
+                static_cast<int>(part.landmark_measurements.size()));
+      EXPECT_EQ(c.num_priors, static_cast<int>(part.priors.size()));
+      EXPECT_EQ(c.gauge_vertex_id,
+                part.priors.empty() ? static_cast<int64_t>(1000 * p) : -1);
+      EXPECT_EQ(c.summary.objective, alone.objective);
+      EXPECT_EQ(c.summary.lower_bound, alone.lower_bound);
+      for (int k = 0; k < part.num_poses; ++k) {
+        EXPECT_EQ(x.poses[merged.index[p][k]].R, y.poses[k].R);
+        EXPECT_EQ(x.poses[merged.index[p][k]].t, y.poses[k].t);
+      }
+      for (int k = 0; k < part.num_landmarks; ++k) {
+        EXPECT_EQ(x.landmarks[lm_index[p][k]], y.landmarks[k]);
+      }
+      objective += alone.objective;
+    }
+    EXPECT_EQ(summary.objective, objective);
+    // Every term of the whole graph is counted once.
+    EXPECT_NEAR(summary.objective, EvaluateObjective(g, x.poses, x.landmarks),
+                1e-12 * summary.objective);
+    const std::string report = summary.FullReport();
+    EXPECT_THAT(report, HasSubstr("Landmark measurements"));
+    EXPECT_THAT(report, HasSubstr("world"));
+    // The poses-only overload returns the same poses.
+    ComponentsSummary again;
+    const Poses z = SolveByComponent(g, options, &again);
+    ASSERT_EQ(z.size(), x.poses.size());
+    for (size_t k = 0; k < z.size(); ++k) EXPECT_EQ(z[k].t, x.poses[k].t);
+  }
+}
+
+TEST(ComponentSolver, PriorsJoinTheirComponentsInTheWorldFrame) {
+  // Two landmark maps, each with priors: the priors tie both to the world
+  // frame, so they are one component, solved as one graph.
+  const std::vector<PoseGraph> parts = {
+      RandomWithLandmarks(2, 10, 24, /*priors=*/true),
+      RandomWithLandmarks(2, 8, 25, /*priors=*/true)};
+  std::vector<std::vector<int>> lm_index;
+  const Merged merged = MergeWithLandmarks(parts, &lm_index);
+  std::string error;
+  ASSERT_TRUE(ValidatePoseGraph(merged.graph, &error)) << error;
+  ComponentsSummary summary;
+  Solution x;
+  SolveByComponent(merged.graph, SolverOptions(), &x, &summary);
+  ASSERT_EQ(summary.components.size(), 1u);
+  ASSERT_TRUE(summary.certified()) << summary.FullReport();
+  SolverSummary whole;
+  Solution y;
+  Solve(merged.graph, SolverOptions(), &y, &whole);
+  EXPECT_EQ(summary.objective, whole.objective);
+  EXPECT_EQ(x.landmarks, y.landmarks);
+  EXPECT_EQ(summary.components[0].gauge_vertex_id, -1);
+}
+
 TEST(ComponentSolver, EachComponentHasItsOwnGauge) {
   const std::vector<PoseGraph> parts = {Random(3, 8, 3), Random(3, 6, 4),
                                         Random(3, 1, 5)};

@@ -51,10 +51,11 @@ DEFINE_bool(newton_at_rank_d, ceres_sesync::SolverOptions().newton_at_rank_d,
             "cheap, else once its first solves are long "
             "(SolverOptions::newton_at_rank_d).");
 DEFINE_bool(components, false,
-            "Solve a disconnected graph per connected component, each in its "
-            "own gauge (its first pose, or its FIX pose, fixed); the report "
-            "and --json list the components. Without it a disconnected graph "
-            "is an input error.");
+            "Solve a disconnected graph per connected component (poses and "
+            "landmarks linked by measurements), each in its own gauge (its "
+            "first pose, or its FIX pose, fixed; the one with the priors in "
+            "the world frame); the report and --json list the components. "
+            "Without it a disconnected graph is an input error.");
 
 DEFINE_bool(robust, false,
             "solve: outlier-robust solve (GNC with truncated least squares "
@@ -131,6 +132,9 @@ void AddComponents(const PoseGraph& graph, const ComponentsSummary& summary,
                    internal::JsonWriter* json) {
   json->Int("num_poses", summary.num_poses);
   json->Int("num_measurements", summary.num_measurements);
+  json->Int("num_landmarks", summary.num_landmarks);
+  json->Int("num_landmark_measurements", summary.num_landmark_measurements);
+  json->Int("num_priors", summary.num_priors);
   json->Int("dimension", summary.dimension);
   json->Number("objective", summary.objective);
   json->Number("lower_bound", summary.lower_bound);
@@ -147,6 +151,9 @@ void AddComponents(const PoseGraph& graph, const ComponentsSummary& summary,
     json->Int("gauge_vertex_id", c.gauge_vertex_id);
     json->BeginArray("vertex_ids");
     for (int v : c.poses) json->Int(graph.vertex_ids[v]);
+    json->EndArray();
+    json->BeginArray("landmark_ids");
+    for (int l : c.landmarks) json->Int(graph.landmark_ids[l]);
     json->EndArray();
     AddSummary(c.summary, json);
     json->EndObject();
@@ -266,7 +273,7 @@ int RunSolve(const Args& args) {
   RobustSolverSummary robust;
   if (FLAGS_components) {
     ComponentsSummary summary;
-    solution.poses = SolveByComponent(graph, options, &summary);
+    SolveByComponent(graph, options, &solution, &summary);
     if (progress) progress->Finish();
     std::cout << summary.FullReport() << std::flush;
     if (summary.status == SolverSummary::Status::kInvalidInput) {

@@ -323,12 +323,15 @@ def solve(graph, initial_rotations=None, *, robust=False, **options):
 
 def solve_components(graph, **options):
     """Solves each connected component of a (possibly disconnected) graph on
-    its own, in its own gauge (its first pose, or its FIX pose, fixed).
+    its own (poses and landmarks linked by measurements; all priors are in
+    one component), in its own gauge (its first pose, or its FIX pose,
+    fixed; the component with the priors in the world frame, gauge_vertex_id
+    -1).
 
     Keyword options as for solve(). Returns a ComponentsResult: components
-    (each with poses, gauge_vertex_id and its SolverSummary), the sums
-    objective / lower_bound / ..., status, certified, and rotations and
-    translations of the whole graph.
+    (each with poses, landmarks, gauge_vertex_id and its SolverSummary), the
+    sums objective / lower_bound / ..., status, certified, and rotations,
+    translations and landmarks of the whole graph.
     """
     options = _options(SolverOptions, options, "solve_components")
     return _core._solve_by_component(graph, options)

@@ -44,7 +44,7 @@ struct SolveResult : SolverSummary {
 };
 
 struct ComponentsResult : ComponentsSummary {
-  py::object rotations, translations;
+  py::object rotations, translations, landmarks;
 };
 
 struct RobustResult : RobustSolverSummary {
@@ -368,7 +368,13 @@ void BindComponents(py::module_& m) {
       .get(
           "poses", [](const S::Component& c) { return IndexArray(c.poses); },
           "indices of the component's poses in the whole graph")
+      .get(
+          "landmarks",
+          [](const S::Component& c) { return IndexArray(c.landmarks); },
+          "indices of the component's landmarks in the whole graph")
       .ro("num_measurements", &S::Component::num_measurements)
+      .ro("num_landmark_measurements", &S::Component::num_landmark_measurements)
+      .ro("num_priors", &S::Component::num_priors)
       .ro("gauge_vertex_id", &S::Component::gauge_vertex_id)
       .ro("summary", &S::Component::summary);
   Fields(cls)
@@ -377,6 +383,9 @@ void BindComponents(py::module_& m) {
       .ro("dimension", &S::dimension)
       .ro("num_poses", &S::num_poses)
       .ro("num_measurements", &S::num_measurements)
+      .ro("num_landmarks", &S::num_landmarks)
+      .ro("num_landmark_measurements", &S::num_landmark_measurements)
+      .ro("num_priors", &S::num_priors)
       .ro("components", &S::components)
       .ro("objective", &S::objective)
       .ro("lower_bound", &S::lower_bound)
@@ -390,10 +399,12 @@ void BindComponents(py::module_& m) {
   py::class_<ComponentsResult, S> result(
       m, "ComponentsResult",
       "solve_components()'s result: every ComponentsSummary field, the poses "
-      "of the whole graph as numpy arrays, and summary (the full report).");
+      "and landmark positions of the whole graph as numpy arrays, and summary "
+      "(the full report).");
   Fields(result)
       .ro("rotations", &ComponentsResult::rotations)
-      .ro("translations", &ComponentsResult::translations);
+      .ro("translations", &ComponentsResult::translations)
+      .ro("landmarks", &ComponentsResult::landmarks);
   result.def_property_readonly("summary", &S::FullReport);
 }
 
@@ -590,6 +601,21 @@ void BindPoseGraph(py::module_& m) {
             return IndexArray(c.measurements);
           },
           "indices of the component's measurements in the whole graph")
+      .get(
+          "landmarks",
+          [](const PoseGraphComponent& c) { return IndexArray(c.landmarks); },
+          "indices of the component's landmarks in the whole graph")
+      .get(
+          "landmark_measurements",
+          [](const PoseGraphComponent& c) {
+            return IndexArray(c.landmark_measurements);
+          },
+          "indices of the component's landmark measurements in the whole "
+          "graph")
+      .get(
+          "priors",
+          [](const PoseGraphComponent& c) { return IndexArray(c.priors); },
+          "indices of the component's priors in the whole graph")
       .ro("graph", &PoseGraphComponent::graph);
   cls.def("split_into_components", &SplitIntoComponents,
           "The connected components (PoseGraphComponent), in order of their "
@@ -926,21 +952,21 @@ void BindSolvers(py::module_& m) {
     result.landmarks = LandmarksArray(solution.landmarks, graph.dimension);
     return result;
   });
-  m.def("_solve_by_component",
-        [](const PoseGraph& graph, SolverOptions options) {
-          MakeInterruptible(&options);
-          ComponentsResult result;
-          Poses poses;
-          {
-            py::gil_scoped_release release;
-            poses = SolveByComponent(graph, options, &result);
-          }
-          if (result.status == Status::kInvalidInput)
-            InputError(result.message);
-          result.rotations = RotationsArray(poses, graph.dimension);
-          result.translations = TranslationsArray(poses, graph.dimension);
-          return result;
-        });
+  m.def("_solve_by_component", [](const PoseGraph& graph,
+                                  SolverOptions options) {
+    MakeInterruptible(&options);
+    ComponentsResult result;
+    Solution solution;
+    {
+      py::gil_scoped_release release;
+      SolveByComponent(graph, options, &solution, &result);
+    }
+    if (result.status == Status::kInvalidInput) InputError(result.message);
+    result.rotations = RotationsArray(solution.poses, graph.dimension);
+    result.translations = TranslationsArray(solution.poses, graph.dimension);
+    result.landmarks = LandmarksArray(solution.landmarks, graph.dimension);
+    return result;
+  });
   m.def("_certify", [](const PoseGraph& graph, py::handle rotations,
                        py::handle translations, py::handle landmarks,
                        CertifyOptions options) {
