@@ -383,6 +383,9 @@ std::string CheckOptions(const RobustSolverOptions& o, int d) {
   if (o.max_consistency_rounds < 0) {
     return "max_consistency_rounds must be >= 0";
   }
+  if (o.max_removal_trials < 0) {
+    return "max_removal_trials must be >= 0";
+  }
   if (o.max_readmission_trials < 0) {
     return "max_readmission_trials must be >= 0";
   }
@@ -899,7 +902,10 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     // (Only under a time limit: the report may tighten the proof in
     // double-double, which the final report does otherwise.)
     const bool snapshots = options.max_time_s > 0;
-    if (snapshots && options.max_readmission_trials > 0 && !out_of_time) {
+    if (snapshots &&
+        (options.max_readmission_trials > 0 ||
+         options.max_removal_trials > 0) &&
+        !out_of_time) {
       report_accepted();
     }
     auto accepted_sum = [&](const std::vector<double>& costs,
@@ -908,19 +914,21 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       for (size_t k = 0; k < K; ++k) sum += set[k] ? costs[k] : 0.0;
       return sum;
     };
-    for (int trial = 0; trial < options.max_readmission_trials; ++trial) {
-      f = TermCosts(graph, run.x);
-      // The accepted set's a-posteriori variance factor at its optimum:
-      // its cost over its redundancy (the accepted terms' degrees of
-      // freedom beyond the unknowns': d(d+1)/2 per measurement beyond a
-      // spanning tree in a pose graph).
-      const double accepted_cost = accepted_sum(f, run.accepted);
+    // The accepted set's a-posteriori variance factor at its optimum (its
+    // cost over its redundancy: the accepted terms' degrees of freedom
+    // beyond the unknowns', d(d+1)/2 per measurement beyond a spanning tree
+    // in a pose graph), clamped to [readmission_min_scale, 1].
+    auto variance_scale = [&](double accepted_cost) {
       const double redundancy =
           static_cast<double>(accepted_dofs(run.accepted) - unknown_dofs);
-      const double scale = redundancy > 0
-                               ? std::clamp(accepted_cost / redundancy,
-                                            options.readmission_min_scale, 1.0)
-                               : 1.0;
+      return redundancy > 0 ? std::clamp(accepted_cost / redundancy,
+                                         options.readmission_min_scale, 1.0)
+                            : 1.0;
+    };
+    for (int trial = 0; trial < options.max_readmission_trials; ++trial) {
+      f = TermCosts(graph, run.x);
+      const double accepted_cost = accepted_sum(f, run.accepted);
+      const double scale = variance_scale(accepted_cost);
       int candidate = -1;
       for (size_t k = 0; k < K; ++k) {
         if (run.accepted[k] || known[k] || tried[k] ||
@@ -960,6 +968,88 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         if (!make_consistent()) return disconnected("");
         if (snapshots) report_accepted();
       } else {
+        restore = true;
+      }
+    }
+    // Removal trials: the accepted terms (known inliers excepted) with the
+    // largest f_k / c_k^2, one at a time: the accepted set without it is
+    // solved and made consistent (the rounds may re-admit it, and re-admit
+    // the terms that a wrong measurement had bent the map away from), and
+    // kept iff the TLS cost is lower and the terms the rounds admitted fit
+    // as the re-admission rule asks: the rise of the accepted cost from the
+    // set without the candidate to the trial's result is below s sum c_k^2
+    // over them. A removal that would disconnect the accepted graph is not
+    // tried.
+    std::vector<char> removal_tried(K, 0);
+    for (int trial = 0; trial < options.max_removal_trials && !out_of_time;
+         ++trial) {
+      f = TermCosts(graph, run.x);
+      int candidate = -1;
+      for (size_t k = 0; k < K; ++k) {
+        if (!run.accepted[k] || known[k] || removal_tried[k]) continue;
+        if (candidate < 0 || f[k] / c2[k] > f[candidate] / c2[candidate]) {
+          candidate = static_cast<int>(k);
+        }
+      }
+      if (candidate < 0) break;
+      removal_tried[candidate] = 1;
+      std::vector<char> set = run.accepted;
+      set[candidate] = 0;
+      {
+        MeasurementWeights binary(K);
+        for (size_t k = 0; k < K; ++k) binary[k] = set[k] ? 1.0 : 0.0;
+        std::string ignored;
+        if (!internal::CheckMeasurementWeights(graph, binary, &ignored)) {
+          continue;
+        }
+      }
+      if (!budget(solve_options)) {
+        out_of_time = true;
+        break;
+      }
+      ++run.record.removal_trials;
+      const double tls_before = TlsCost(f, known, c2);
+      const double scale = variance_scale(accepted_sum(f, run.accepted));
+      std::vector<char> saved_accepted = run.accepted;
+      Eigen::MatrixXd saved_Y = Y;
+      Solution saved_x = run.x;
+      const int saved_rounds = run.record.consistency_rounds;
+      SolverSummary saved_summary = accepted_summary;
+      run.accepted = set;
+      if (!solve_accepted()) {
+        return disconnected("removal trial: ");
+      }
+      const double removed_cost =
+          accepted_sum(TermCosts(graph, run.x), run.accepted);
+      const bool consistent = make_consistent();
+      const std::vector<double> f_trial = TermCosts(graph, run.x);
+      double admitted_c2 = 0;
+      for (size_t k = 0; k < K; ++k) {
+        if (run.accepted[k] && !set[k]) admitted_c2 += c2[k];
+      }
+      const double rise = accepted_sum(f_trial, run.accepted) - removed_cost;
+      // (A trial cut short by the time limit is not kept.)
+      bool kept =
+          consistent && !out_of_time &&
+          problem.summary().status != SolverSummary::Status::kTimeLimit &&
+          TlsCost(f_trial, known, c2) < tls_before &&
+          rise <= scale * admitted_c2;
+      if (kept) {
+        // Only to a set whose optimum is certified: a wrong measurement
+        // that bends the map to fit tends to leave the relaxation inexact.
+        report_accepted();
+        kept = problem.summary().certified();
+      }
+      if (kept) {
+        ++run.record.removals;
+        restore = false;
+      } else {
+        run.accepted = std::move(saved_accepted);
+        Y = std::move(saved_Y);
+        run.x = std::move(saved_x);
+        run.record.consistency_rounds = saved_rounds;
+        accepted_summary = std::move(saved_summary);
+        message.clear();
         restore = true;
       }
     }
@@ -1163,6 +1253,7 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
   s.iterations = best.record.iterations;
   s.consistency_rounds = best.record.consistency_rounds;
   s.readmissions = best.record.readmissions;
+  s.removals = best.record.removals;
   s.history = std::move(best.history);
   if (!s.history.empty()) s.initial_mu = s.history[0].mu;
   s.weights_binary = best.weights_binary;
@@ -1299,10 +1390,12 @@ std::string RobustSolverSummary::FullReport(bool all_edges) const {
          static_cast<int>(outlier_priors.size()));
   }
   line("%-34s %d\n", "Consistency rounds", consistency_rounds);
+  const bool selected =
+      selected_run >= 0 && selected_run < static_cast<int>(runs.size());
   line("%-34s %d (of %d trials)\n", "Re-admitted measurements", readmissions,
-       selected_run >= 0 && selected_run < static_cast<int>(runs.size())
-           ? runs[selected_run].readmission_trials
-           : 0);
+       selected ? runs[selected_run].readmission_trials : 0);
+  line("%-34s %d (of %d trials)\n", "Removed measurements", removals,
+       selected ? runs[selected_run].removal_trials : 0);
   line("%-34s %d rejected with f_k <= c^2, %d accepted with f_k > c^2\n",
        "Consistency at the result", num_rejected_within_threshold,
        num_accepted_beyond_threshold);

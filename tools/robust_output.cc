@@ -27,6 +27,7 @@ void AddRobustJson(const RobustSolverSummary& summary,
   json->Int("gnc_iterations", summary.iterations);
   json->Int("consistency_rounds", summary.consistency_rounds);
   json->Int("readmissions", summary.readmissions);
+  json->Int("removals", summary.removals);
   json->Int("num_inliers", summary.num_inliers);
   json->Int("num_outliers", summary.num_outliers);
   json->BeginArray("outlier_edges");

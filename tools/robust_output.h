@@ -17,9 +17,9 @@ bool ParseKnownInliers(const std::string& name,
 
 // Adds to the solve's JSON: "robust": true, "robust_status",
 // "inlier_threshold", "gnc_iterations", "consistency_rounds", "readmissions",
-// "num_inliers", "num_outliers", "outlier_edges" (0-based indices of the
-// rejected measurements in the order of the file's pose-pose EDGE lines),
-// with landmarks or priors "outlier_landmark_measurements" and
+// "removals", "num_inliers", "num_outliers", "outlier_edges" (0-based indices
+// of the rejected measurements in the order of the file's pose-pose EDGE
+// lines), with landmarks or priors "outlier_landmark_measurements" and
 // "outlier_priors" (0-based, in the order of the file's landmark and prior
 // EDGE lines), and "edges" (one object per term, measurements first:
 // kind (measurement|landmark|prior), index, weight, inlier, known_inlier,

@@ -1029,6 +1029,7 @@ void BindRobust(py::module_& m) {
       .rw("max_readmission_trials", &O::max_readmission_trials)
       .rw("readmission_max_cost", &O::readmission_max_cost)
       .rw("readmission_min_scale", &O::readmission_min_scale)
+      .rw("max_removal_trials", &O::max_removal_trials)
       .rw("known_inliers", &O::known_inliers);
   KeywordInit<O>(options, "RobustSolverOptions");
 
@@ -1084,6 +1085,8 @@ void BindRobust(py::module_& m) {
       .ro("consistency_rounds", &S::Run::consistency_rounds)
       .ro("readmission_trials", &S::Run::readmission_trials)
       .ro("readmissions", &S::Run::readmissions)
+      .ro("removal_trials", &S::Run::removal_trials)
+      .ro("removals", &S::Run::removals)
       .ro("num_outliers", &S::Run::num_outliers)
       .ro("tls_cost", &S::Run::tls_cost)
       .ro("certified", &S::Run::certified)
@@ -1121,6 +1124,7 @@ void BindRobust(py::module_& m) {
       .ro("inlier_summary", &S::inlier_summary)
       .ro("consistency_rounds", &S::consistency_rounds)
       .ro("readmissions", &S::readmissions)
+      .ro("removals", &S::removals)
       .ro("pattern_rebuilds", &S::pattern_rebuilds)
       .ro("concurrent_runs", &S::concurrent_runs)
       .ro("initial_time_s", &S::initial_time_s)
