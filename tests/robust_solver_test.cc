@@ -469,19 +469,21 @@ TEST(RobustSolver, StaircaseSkipsTheTestsDuringATopLevelEnteredByAnEscape) {
   }
 }
 
-// A 3 x 3 x 3 cube at the paper's noise (kappa 16.67, tau 75) plus random
-// wrong closures at 30% (cube and outlier seed `seed`).
+// A side^3 cube (3 x 3 x 3 by default) at the paper's noise (kappa 16.67,
+// tau 75) plus random wrong closures at `fraction` (30% by default; cube
+// and outlier seed `seed`).
 bool SmallNoisyCubeWithOutliers(uint64_t seed, PoseGraph* corrupted,
-                                std::vector<int>* added) {
+                                std::vector<int>* added, int side = 3,
+                                double fraction = 0.3) {
   CubeOptions cube;
-  cube.side = 3;
+  cube.side = side;
   cube.kappa = 16.67;
   cube.tau = 75;
   cube.seed = seed;
   PoseGraph clean;
   if (!GenerateCube(cube, &clean, nullptr, nullptr)) return false;
   OutlierOptions o;
-  o.fraction = 0.3;
+  o.fraction = fraction;
   o.seed = seed;
   return AddOutliers(clean, o, corrupted, added, nullptr);
 }
@@ -658,16 +660,9 @@ TEST(RobustSolver, RemovalTrialDropsAWrongClosureTheMapBentTo) {
 // relaxation no longer exact (the inlier problem not certified); that trial
 // is not kept, and exactly the wrong closures are rejected, certified.
 TEST(RobustSolver, RemovalTrialKeepsOnlyCertifiedResults) {
-  CubeOptions cube;
-  cube.side = 4;
-  cube.seed = 14;
-  PoseGraph clean, corrupted;
-  ASSERT_TRUE(GenerateCube(cube, &clean, nullptr, nullptr));
-  OutlierOptions o;
-  o.fraction = 0.3;
-  o.seed = 14;
+  PoseGraph corrupted;
   std::vector<int> added;
-  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+  ASSERT_TRUE(SmallNoisyCubeWithOutliers(14, &corrupted, &added, 4, 0.3));
   RobustSolverSummary s;
   SolveRobust(corrupted, Options(), &s);
   EXPECT_TRUE(s.certified()) << s.FullReport();
@@ -682,18 +677,9 @@ TEST(RobustSolver, RemovalTrialKeepsOnlyCertifiedResults) {
 // closure that the map bends to fit (it lowers the TLS cost); the scaled
 // rule (default) keeps it out, and exactly the wrong closures are rejected.
 TEST(RobustSolver, ScaledReadmissionKeepsOutAWrongClosureTheMapBendsToFit) {
-  CubeOptions cube;
-  cube.side = 3;
-  cube.kappa = 16.67;
-  cube.tau = 75;
-  cube.seed = 25;
-  PoseGraph clean, corrupted;
-  ASSERT_TRUE(GenerateCube(cube, &clean, nullptr, nullptr));
-  OutlierOptions o;
-  o.fraction = 0.5;
-  o.seed = 25;
+  PoseGraph corrupted;
   std::vector<int> added;
-  ASSERT_TRUE(AddOutliers(clean, o, &corrupted, &added, nullptr));
+  ASSERT_TRUE(SmallNoisyCubeWithOutliers(25, &corrupted, &added, 3, 0.5));
   ASSERT_FALSE(added.empty());
   // Both with the complete staircase in the first solve (from its result
   // GNC accepts the set that the bare rule then extends).
