@@ -1028,10 +1028,13 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
         if (run.accepted[k] && !set[k]) admitted_c2 += c2[k];
       }
       const double rise = accepted_sum(f_trial, run.accepted) - removed_cost;
-      // (A trial cut short by the time limit is not kept.)
+      // (A trial cut short by the time limit is not kept.
+      // Nor one whose rounds re-admitted the candidate and nothing else
+      // changed: the same set, its cost lower only by round-off.)
       bool kept =
           consistent && !out_of_time &&
           problem.summary().status != SolverSummary::Status::kTimeLimit &&
+          run.accepted != saved_accepted &&
           TlsCost(f_trial, known, c2) < tls_before &&
           rise <= scale * admitted_c2;
       if (kept) {
