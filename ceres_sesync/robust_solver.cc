@@ -973,13 +973,14 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
     }
     // Removal trials: the accepted terms (known inliers excepted) with the
     // largest f_k / c_k^2, one at a time: the accepted set without it is
-    // solved and made consistent (the rounds may re-admit it, and re-admit
-    // the terms that a wrong measurement had bent the map away from), and
-    // kept iff the TLS cost is lower and the terms the rounds admitted fit
-    // as the re-admission rule asks: the rise of the accepted cost from the
-    // set without the candidate to the trial's result is below s sum c_k^2
-    // over them. A removal that would disconnect the accepted graph is not
-    // tried.
+    // solved and, if that lets a rejected term fit, made consistent (the
+    // rounds may re-admit the candidate, and re-admit the terms that a wrong
+    // measurement had bent the map away from), and kept iff the set
+    // changed, the TLS cost is lower, the terms the rounds admitted fit as
+    // the re-admission rule asks (the rise of the accepted cost from the set
+    // without the candidate to the trial's result is below s sum c_k^2 over
+    // them) and the new set's optimum is certified. A removal that would
+    // disconnect the accepted graph is not tried.
     std::vector<char> removal_tried(K, 0);
     for (int trial = 0; trial < options.max_removal_trials && !out_of_time;
          ++trial) {
@@ -1019,9 +1020,18 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       if (!solve_accepted()) {
         return disconnected("removal trial: ");
       }
-      const double removed_cost =
-          accepted_sum(TermCosts(graph, run.x), run.accepted);
-      const bool consistent = make_consistent();
+      const std::vector<double> f_removed = TermCosts(graph, run.x);
+      const double removed_cost = accepted_sum(f_removed, run.accepted);
+      // The rounds run only if the removal lets a rejected term other than
+      // the candidate fit within its c_k^2: otherwise they could only
+      // reject more of the map the candidate held (many solves at scale for
+      // a trial that is then rarely kept).
+      bool admits = false;
+      for (size_t k = 0; k < K && !admits; ++k) {
+        admits = !set[k] && !known[k] && static_cast<int>(k) != candidate &&
+                 f_removed[k] <= c2[k];
+      }
+      const bool consistent = admits && make_consistent();
       const std::vector<double> f_trial = TermCosts(graph, run.x);
       double admitted_c2 = 0;
       for (size_t k = 0; k < K; ++k) {
