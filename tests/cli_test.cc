@@ -3,6 +3,7 @@
 // `solve --components`, and landmarks and priors through solve and certify.
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <set>
@@ -24,8 +25,10 @@ using test_util::IsValidJson;
 using test_util::JsonNumber;
 using test_util::ReadText;
 using test_util::RunResult;
+using test_util::RunTool;
 using test_util::RunToolWithOutput;
 using test_util::TempPath;
+using test_util::ValueAfter;
 using test_util::WriteText;
 using testing::HasSubstr;
 using testing::Not;
@@ -119,6 +122,36 @@ TEST_F(CliTest, UnknownAndForeignFlagsAreUsageErrors) {
   EXPECT_TRUE(fs::exists(output));
   fs::remove(output);
 }
+
+#ifdef __GLIBC__
+// The tool starts itself once more with glibc's huge-page heap tunable
+// added to GLIBC_TUNABLES (tools/ceres_sesync_main.cc); a setting of the
+// user's is kept, other tunables too.
+TEST_F(CliTest, RestartsWithTheHugePageHeapTunable) {
+  const std::string graph = TempPath("tunable.g2o");
+  ASSERT_EQ(RunTool("generate cube --side 2 --output " + graph), 0);
+  const char* saved = std::getenv("GLIBC_TUNABLES");
+  const std::string previous = saved != nullptr ? saved : "";
+  auto tunables_seen = [&]() {
+    const RunResult run =
+        RunToolWithOutput("solve " + graph + " --verbose --v=1");
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return ValueAfter(run.err, "GLIBC_TUNABLES=");
+  };
+  unsetenv("GLIBC_TUNABLES");
+  EXPECT_EQ(tunables_seen(), "glibc.malloc.hugetlb=1");
+  setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=0", 1);
+  EXPECT_EQ(tunables_seen(), "glibc.malloc.hugetlb=0");
+  setenv("GLIBC_TUNABLES", "glibc.malloc.check=0", 1);
+  EXPECT_EQ(tunables_seen(), "glibc.malloc.check=0:glibc.malloc.hugetlb=1");
+  if (saved != nullptr) {
+    setenv("GLIBC_TUNABLES", previous.c_str(), 1);
+  } else {
+    unsetenv("GLIBC_TUNABLES");
+  }
+  fs::remove(graph);
+}
+#endif
 
 // Two triangles (vertices 0-2 and 5-7): a disconnected graph.
 const char kTwoComponents[] =

@@ -337,7 +337,43 @@ bool FlagIsSet(const char* name) {
 
 }  // namespace
 
+namespace {
+
+// glibc's malloc backs its heap with transparent huge pages (madvise) when
+// its tunable glibc.malloc.hugetlb is 1: one page fault per 2 MiB instead of
+// per 4 KiB. With KeepFreedMemory() every block comes from the heap, so that
+// covers the solver's allocations. Tunables are read when the process
+// starts, so the tool starts itself once more with the tunable added, unless
+// GLIBC_TUNABLES already names it (a user's choice, e.g. =0, is kept). Where
+// the exec fails the tool goes on as it is. Measured (CLI solve, one run,
+// the 2-core VM of bench/ where a fault costs ~7-12 us; THP "madvise"):
+// kitti_00 99 -> 48 ms (5,610 -> 1,260 faults), manhattan 0.10 -> 0.06 s,
+// city10000 0.29 -> 0.19 s, sphere2500 0.16 -> 0.12 s; peak RSS +2-10%.
+void RestartWithHugePageHeap(char** argv) {
+#ifdef __GLIBC__
+  constexpr char kTunable[] = "glibc.malloc.hugetlb";
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  std::string value = tunables != nullptr ? tunables : "";
+  if (value.find(kTunable) != std::string::npos) return;
+  const std::string previous = value;
+  value += (value.empty() ? "" : ":") + std::string(kTunable) + "=1";
+  if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  // Still here: the exec failed; go on with the environment as it was.
+  if (tunables != nullptr) {
+    setenv("GLIBC_TUNABLES", previous.c_str(), 1);
+  } else {
+    unsetenv("GLIBC_TUNABLES");
+  }
+#else
+  (void)argv;
+#endif
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  RestartWithHugePageHeap(argv);
   // Freed memory stays for the next factorization (process_memory.h).
   ceres_sesync::KeepFreedMemory();
   gflags::SetUsageMessage(GeneralHelp());
@@ -370,6 +406,8 @@ int main(int argc, char** argv) {
   if (!FLAGS_verbose && FLAGS_minloglevel < google::GLOG_WARNING) {
     FLAGS_minloglevel = google::GLOG_WARNING;
   }
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  VLOG(1) << "GLIBC_TUNABLES=" << (tunables != nullptr ? tunables : "");
   if (name.empty()) {
     std::fputs(GeneralHelp().c_str(), stderr);
     return kUsageOrInputError;
