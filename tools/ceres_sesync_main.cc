@@ -344,8 +344,10 @@ namespace {
 // per 4 KiB. With KeepFreedMemory() every block comes from the heap, so that
 // covers the solver's allocations. Tunables are read when the process
 // starts, so the tool starts itself once more with the tunable added, unless
-// GLIBC_TUNABLES already names it (a user's choice, e.g. =0, is kept). Where
-// the exec fails the tool goes on as it is. Measured (CLI solve, one run,
+// GLIBC_TUNABLES already names it (a user's choice, e.g. =0, is kept: the
+// way to run the tool without the restart, e.g. under valgrind, which does
+// not follow an exec by default). Where the exec fails the tool goes on as
+// it is. Measured (CLI solve, one run,
 // the 2-core VM of bench/ where a fault costs ~7-12 us; THP "madvise"):
 // kitti_00 99 -> 48 ms (5,610 -> 1,260 faults), manhattan 0.10 -> 0.06 s,
 // city10000 0.29 -> 0.19 s, sphere2500 0.16 -> 0.12 s; peak RSS +2-10%.
