@@ -347,10 +347,10 @@ namespace {
 // GLIBC_TUNABLES already names it (a user's choice, e.g. =0, is kept: the
 // way to run the tool without the restart, e.g. under valgrind, which does
 // not follow an exec by default). Where the exec fails the tool goes on as
-// it is. Measured (CLI solve, one run,
-// the 2-core VM of bench/ where a fault costs ~7-12 us; THP "madvise"):
-// kitti_00 99 -> 48 ms (5,610 -> 1,260 faults), manhattan 0.10 -> 0.06 s,
-// city10000 0.29 -> 0.19 s, sphere2500 0.16 -> 0.12 s; peak RSS +2-10%.
+// it is. Measured (CLI solve, one run, the 2-core VM of bench/ where a fault
+// costs ~7-12 us; THP "madvise"): kitti_00 99 -> 48 ms (5,610 -> 1,260
+// faults), manhattan 0.10 -> 0.06 s, city10000 0.29 -> 0.19 s, sphere2500
+// 0.16 -> 0.12 s; peak RSS +2-10%.
 void RestartWithHugePageHeap(char** argv) {
 #ifdef __GLIBC__
   constexpr char kTunable[] = "glibc.malloc.hugetlb";
