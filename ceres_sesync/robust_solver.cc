@@ -832,12 +832,16 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       return record();
     }
     bool out_of_time = false;
+    // The weights that restrict the problem to `set`.
+    auto binary_weights = [&](const std::vector<char>& set) {
+      MeasurementWeights binary(K);
+      for (size_t k = 0; k < K; ++k) binary[k] = set[k] ? 1.0 : 0.0;
+      return binary;
+    };
     // Solves the problem restricted to `set` from *Y_io (updated in place).
     auto solve_set = [&](const std::vector<char>& set, Eigen::MatrixXd* Y_io,
                          Solution* x_out) {
-      MeasurementWeights binary(K);
-      for (size_t k = 0; k < K; ++k) binary[k] = set[k] ? 1.0 : 0.0;
-      if (!problem.SetWeights(binary, &message)) return false;
+      if (!problem.SetWeights(binary_weights(set), &message)) return false;
       *Y_io = ReduceRank(*Y_io, d, r0, kRankTolerance);
       problem.staircase().Run(Y_io);
       Solution x = problem.staircase().Round(*Y_io);
@@ -996,13 +1000,10 @@ void SolveRobust(const PoseGraph& graph, const RobustSolverOptions& options,
       removal_tried[candidate] = 1;
       std::vector<char> set = run.accepted;
       set[candidate] = 0;
-      {
-        MeasurementWeights binary(K);
-        for (size_t k = 0; k < K; ++k) binary[k] = set[k] ? 1.0 : 0.0;
-        std::string ignored;
-        if (!internal::CheckMeasurementWeights(graph, binary, &ignored)) {
-          continue;
-        }
+      std::string ignored;
+      if (!internal::CheckMeasurementWeights(graph, binary_weights(set),
+                                             &ignored)) {
+        continue;
       }
       if (!budget(solve_options)) {
         out_of_time = true;

@@ -604,23 +604,21 @@ TEST(RobustSolver, RemovalTrialDropsAWrongClosureTheMapBentTo) {
     p.t = Eigen::Vector2d(5 * std::cos(a), 5 * std::sin(a));
     truth.push_back(p);
   }
-  auto exact = [&](int i, int j, double precision) {
+  auto add = [&](int i, int j, double precision) {
     RelativePoseMeasurement m;
     m.i = i;
     m.j = j;
-    m.R = truth[i].R.transpose() * truth[j].R;
-    m.t = truth[i].R.transpose() * (truth[j].t - truth[i].t);
     m.kappa = m.tau = precision;
-    return m;
+    graph.measurements.push_back(m);
   };
-  for (int i = 0; i + 1 < n; ++i)
-    graph.measurements.push_back(exact(i, i + 1, 100));
-  graph.measurements.push_back(exact(n - 1, 0, 100));    // 11: true.
-  graph.measurements.push_back(exact(n - 2, 1, 100));    // 12: true.
-  RelativePoseMeasurement wrong = exact(n - 1, 0, 500);  // 13: wrong.
+  for (int i = 0; i + 1 < n; ++i) add(i, i + 1, 100);
+  add(n - 1, 0, 100);  // 11: true.
+  add(n - 2, 1, 100);  // 12: true.
+  add(n - 1, 0, 500);  // 13: wrong (below).
+  test_util::MakeMeasurementsExact(truth, &graph);
+  RelativePoseMeasurement& wrong = graph.measurements.back();
   wrong.t += Eigen::Vector2d(1, 0);
   wrong.R = wrong.R * Eigen::Rotation2Dd(0.2).toRotationMatrix();
-  graph.measurements.push_back(wrong);
 
   RobustSolverOptions options = Options();
   options.max_removal_trials = 0;
@@ -643,14 +641,8 @@ TEST(RobustSolver, RemovalTrialDropsAWrongClosureTheMapBentTo) {
   EXPECT_NEAR(with.runs[with.selected_run].tls_cost, c2, 1e-8 * c2);
   EXPECT_LT(with.runs[with.selected_run].tls_cost,
             without.runs[without.selected_run].tls_cost);
-  // The truth, up to the gauge (pose 0 at the identity).
-  for (int i = 0; i < n; ++i) {
-    const Eigen::MatrixXd R = truth[0].R.transpose() * truth[i].R;
-    const Eigen::VectorXd t =
-        truth[0].R.transpose() * (truth[i].t - truth[0].t);
-    EXPECT_LT((x[i].R - R).norm(), 1e-6) << i;
-    EXPECT_LT((x[i].t - t).norm(), 1e-6) << i;
-  }
+  // The truth, up to the gauge.
+  EXPECT_LT(test_util::GaugeInvariantPoseDistance(x, truth), 1e-6);
   EXPECT_THAT(with.FullReport(), ::testing::HasSubstr("Removed measurements"));
 }
 
